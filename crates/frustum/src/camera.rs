@@ -1,0 +1,648 @@
+use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
+
+use crate::geometry::{DPlane, Plane};
+use crate::{Aabb, FrustumError, math, projection};
+
+/// Smallest accepted relative thickness `(far - near) / far` of a depth range: below
+/// this, `f32` depth cannot tell the two planes apart.
+pub(crate) const MIN_RELATIVE_DEPTH_RANGE: f64 = 1e-5;
+
+/// How a camera projects view space; the view looks down `-Z`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Symmetric perspective with a finite far plane.
+    Perspective {
+        /// Vertical field of view in radians, in `(0, pi)`.
+        fov_y: f32,
+        /// Width over height, positive.
+        aspect: f32,
+        /// Near plane distance, positive.
+        near: f32,
+        /// Far plane distance, above `near`.
+        far: f32,
+    },
+    /// Symmetric perspective with the far plane at infinity; shadows are cast up to
+    /// `shadow_distance`.
+    InfinitePerspective {
+        /// Vertical field of view in radians, in `(0, pi)`.
+        fov_y: f32,
+        /// Width over height, positive.
+        aspect: f32,
+        /// Near plane distance, positive.
+        near: f32,
+        /// View depth up to which shadows are computed, above `near`.
+        shadow_distance: f32,
+    },
+    /// Orthographic box `[left, right] x [bottom, top]` between view depths `near` and `far`.
+    Orthographic {
+        /// Left edge in view units.
+        left: f32,
+        /// Right edge, above `left`.
+        right: f32,
+        /// Bottom edge.
+        bottom: f32,
+        /// Top edge, above `bottom`.
+        top: f32,
+        /// Near view depth (may be zero or negative).
+        near: f32,
+        /// Far view depth, above `near`.
+        far: f32,
+    },
+    /// Any projection matrix in WebGPU clip space (depth in `[0, 1]`, reversed when the
+    /// camera's `reversed_z` is set), possibly off-centre or with an infinite far plane.
+    /// Shadows are cast up to `shadow_distance` or the matrix's far plane, whichever
+    /// is nearer.
+    Custom {
+        /// The projection, WebGPU clip space from view space.
+        clip_from_view: Mat4,
+        /// View depth up to which shadows are computed.
+        shadow_distance: f32,
+    },
+}
+
+impl Projection {
+    /// A symmetric perspective projection.
+    #[must_use]
+    pub const fn perspective(fov_y: f32, aspect: f32, near: f32, far: f32) -> Self {
+        Self::Perspective {
+            fov_y,
+            aspect,
+            near,
+            far,
+        }
+    }
+}
+
+/// A camera: a rigid view transform and a projection.
+///
+/// View space is right-handed and looks down `-Z`; "view depth" is the distance along
+/// the viewing direction, `-z_view`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Rigid transform from view space to world space (the camera's pose).
+    pub world_from_view: Mat4,
+    /// The projection.
+    pub projection: Projection,
+    /// Whether clip depth runs from 1 at the near plane to 0 at the far plane.
+    pub reversed_z: bool,
+}
+
+impl Camera {
+    /// A camera at `eye` looking along `forward` with `up` roughly up.
+    ///
+    /// # Errors
+    /// [`FrustumError::NonFinite`], [`FrustumError::ZeroDirection`],
+    /// [`FrustumError::UpParallelToView`], or any error of the projection (see
+    /// [`Camera::validate`]).
+    pub fn look_to(
+        eye: Vec3,
+        forward: Vec3,
+        up: Vec3,
+        projection: Projection,
+    ) -> Result<Self, FrustumError> {
+        let world_from_view = world_from_view_look_to(eye, forward, up)?;
+        let camera = Self {
+            world_from_view,
+            projection,
+            reversed_z: false,
+        };
+        camera.validate()?;
+        Ok(camera)
+    }
+
+    /// A camera at `eye` looking at `target`.
+    ///
+    /// # Errors
+    /// As [`Camera::look_to`]; `target == eye` gives [`FrustumError::ZeroDirection`].
+    pub fn look_at(
+        eye: Vec3,
+        target: Vec3,
+        up: Vec3,
+        projection: Projection,
+    ) -> Result<Self, FrustumError> {
+        Self::look_to(eye, target - eye, up, projection)
+    }
+
+    /// This camera with reversed-Z clip depth.
+    #[must_use]
+    pub const fn with_reversed_z(mut self, reversed_z: bool) -> Self {
+        self.reversed_z = reversed_z;
+        self
+    }
+
+    /// Checks the pose and the projection.
+    ///
+    /// # Errors
+    /// [`FrustumError::NonFinite`] for NaN or infinite values,
+    /// [`FrustumError::ZeroDirection`] / [`FrustumError::UpParallelToView`] for a
+    /// degenerate pose, [`FrustumError::InvalidFov`], [`FrustumError::InvalidAspect`],
+    /// [`FrustumError::InvalidDepthRange`] (near <= 0 for perspective, far <= near, or
+    /// a range too thin for `f32`), [`FrustumError::InvalidProjection`] for a custom
+    /// matrix that is singular or does not look down `-Z`.
+    pub fn validate(&self) -> Result<(), FrustumError> {
+        self.geometry().map(|_| ())
+    }
+
+    /// Transform from world space to view space.
+    #[must_use]
+    pub fn view_from_world(&self) -> Mat4 {
+        self.world_from_view.inverse()
+    }
+
+    /// Camera position in world space.
+    #[must_use]
+    pub fn eye(&self) -> Vec3 {
+        self.world_from_view.w_axis.truncate()
+    }
+
+    /// Unit viewing direction in world space.
+    #[must_use]
+    pub fn forward(&self) -> Vec3 {
+        (-self.world_from_view.z_axis.truncate()).normalize_or_zero()
+    }
+
+    /// View depth (distance along the viewing direction) of a world point.
+    #[must_use]
+    pub fn view_depth(&self, world: Vec3) -> f32 {
+        (world - self.eye()).dot(self.forward())
+    }
+
+    /// Near and far view depth over which shadows are computed (the far plane, or the
+    /// shadow distance for infinite and custom projections).
+    ///
+    /// # Errors
+    /// As [`Camera::validate`].
+    pub fn depth_range(&self) -> Result<(f32, f32), FrustumError> {
+        let g = self.geometry()?;
+        Ok((g.near as f32, g.far as f32))
+    }
+
+    /// The projection matrix, WebGPU clip space from view space.
+    ///
+    /// # Errors
+    /// As [`Camera::validate`].
+    pub fn clip_from_view(&self) -> Result<Mat4, FrustumError> {
+        self.geometry()?;
+        let rev = self.reversed_z;
+        let m = match self.projection {
+            Projection::Perspective {
+                fov_y,
+                aspect,
+                near,
+                far,
+            } => projection::perspective(
+                f64::from(fov_y),
+                f64::from(aspect),
+                f64::from(near),
+                f64::from(far),
+                rev,
+            )
+            .as_mat4(),
+            Projection::InfinitePerspective {
+                fov_y,
+                aspect,
+                near,
+                ..
+            } => projection::perspective_infinite(
+                f64::from(fov_y),
+                f64::from(aspect),
+                f64::from(near),
+                rev,
+            )
+            .as_mat4(),
+            Projection::Orthographic {
+                left,
+                right,
+                bottom,
+                top,
+                near,
+                far,
+            } => projection::orthographic(
+                f64::from(left),
+                f64::from(right),
+                f64::from(bottom),
+                f64::from(top),
+                f64::from(near),
+                f64::from(far),
+                rev,
+            )
+            .as_mat4(),
+            Projection::Custom { clip_from_view, .. } => clip_from_view,
+        };
+        Ok(m)
+    }
+
+    /// `clip_from_view * view_from_world`.
+    ///
+    /// # Errors
+    /// As [`Camera::validate`].
+    pub fn clip_from_world(&self) -> Result<Mat4, FrustumError> {
+        Ok(self.clip_from_view()? * self.view_from_world())
+    }
+
+    /// The frustum between the near plane and the far plane (or shadow distance).
+    ///
+    /// # Errors
+    /// As [`Camera::validate`].
+    pub fn frustum(&self) -> Result<Frustum, FrustumError> {
+        let g = self.geometry()?;
+        g.slice(g.near, g.far)
+    }
+
+    /// The sub-frustum between view depths `near_depth < far_depth`, which must lie
+    /// inside the camera's depth range (a relative tolerance of `1e-6` is allowed).
+    ///
+    /// # Errors
+    /// As [`Camera::validate`], and [`FrustumError::InvalidDepthRange`] for a depth
+    /// pair that is non-finite, inverted, too thin, or outside the camera's range.
+    pub fn slice(&self, near_depth: f32, far_depth: f32) -> Result<Frustum, FrustumError> {
+        let g = self.geometry()?;
+        let (n, f) = g.check_slice(near_depth, far_depth)?;
+        g.slice(n, f)
+    }
+
+    /// Validated `f64` geometry used by every builder.
+    pub(crate) fn geometry(&self) -> Result<CameraGeometry, FrustumError> {
+        CameraGeometry::new(self)
+    }
+}
+
+fn world_from_view_look_to(eye: Vec3, forward: Vec3, up: Vec3) -> Result<Mat4, FrustumError> {
+    if !(eye.is_finite() && forward.is_finite() && up.is_finite()) {
+        return Err(FrustumError::NonFinite);
+    }
+    let f = forward.as_dvec3();
+    let u = up.as_dvec3();
+    let fwd = f.try_normalize().ok_or(FrustumError::ZeroDirection)?;
+    let up = u.try_normalize().ok_or(FrustumError::ZeroDirection)?;
+    let right = fwd.cross(up);
+    if right.length() < 1e-6 {
+        return Err(FrustumError::UpParallelToView);
+    }
+    let right = right.normalize();
+    let true_up = right.cross(fwd);
+    let m = DMat4::from_cols(
+        right.extend(0.0),
+        true_up.extend(0.0),
+        (-fwd).extend(0.0),
+        eye.as_dvec3().extend(1.0),
+    );
+    Ok(m.as_mat4())
+}
+
+/// A camera checked and converted to `f64`: its pose, depth range, and the four edge
+/// rays of its frustum in view space.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CameraGeometry {
+    pub(crate) world_from_view: DMat4,
+    pub(crate) near: f64,
+    pub(crate) far: f64,
+    /// Corner `i` of the slice at view depth `d` is `ray_origin[i] + d * ray_dir[i]`
+    /// (view space, `ray_dir[i].z == -1`), in the order bottom-left, bottom-right,
+    /// top-right, top-left.
+    pub(crate) ray_origin: [DVec3; 4],
+    pub(crate) ray_dir: [DVec3; 4],
+}
+
+fn finite(x: f32) -> Result<f64, FrustumError> {
+    if x.is_finite() {
+        Ok(f64::from(x))
+    } else {
+        Err(FrustumError::NonFinite)
+    }
+}
+
+fn check_range(near: f64, far: f64, allow_non_positive_near: bool) -> Result<(), FrustumError> {
+    let err = FrustumError::InvalidDepthRange {
+        near: near as f32,
+        far: far as f32,
+    };
+    if (!allow_non_positive_near && near <= 0.0) || far <= near {
+        return Err(err);
+    }
+    let scale = far.abs().max(near.abs());
+    if (far - near) < MIN_RELATIVE_DEPTH_RANGE * scale {
+        return Err(err);
+    }
+    Ok(())
+}
+
+fn symmetric_rays(fov_y: f32, aspect: f32) -> Result<([DVec3; 4], [DVec3; 4]), FrustumError> {
+    let fov = finite(fov_y)?;
+    let aspect = finite(aspect)?;
+    if !(fov > 1e-6 && fov < core::f64::consts::PI - 1e-6) {
+        return Err(FrustumError::InvalidFov);
+    }
+    if !(aspect > 1e-6 && aspect < 1e6) {
+        return Err(FrustumError::InvalidAspect);
+    }
+    let ty = math::tan(fov * 0.5);
+    let tx = ty * aspect;
+    let dir = [
+        DVec3::new(-tx, -ty, -1.0),
+        DVec3::new(tx, -ty, -1.0),
+        DVec3::new(tx, ty, -1.0),
+        DVec3::new(-tx, ty, -1.0),
+    ];
+    Ok(([DVec3::ZERO; 4], dir))
+}
+
+const NDC_XY: [(f64, f64); 4] = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+
+fn unproject(view_from_clip: &DMat4, x: f64, y: f64, z: f64) -> Option<DVec3> {
+    let h = *view_from_clip * DVec4::new(x, y, z, 1.0);
+    (h.w.abs() > 1e-300 && h.is_finite()).then(|| h.truncate() / h.w)
+}
+
+impl CameraGeometry {
+    fn new(camera: &Camera) -> Result<Self, FrustumError> {
+        let m = camera.world_from_view.as_dmat4();
+        if !m.is_finite() {
+            return Err(FrustumError::NonFinite);
+        }
+        // Re-orthonormalize so that slightly non-rigid input stays usable.
+        let back = m.z_axis.truncate();
+        let up = m.y_axis.truncate();
+        let fwd = (-back).try_normalize().ok_or(FrustumError::ZeroDirection)?;
+        let up = up.try_normalize().ok_or(FrustumError::ZeroDirection)?;
+        let right = fwd.cross(up);
+        if right.length() < 1e-6 {
+            return Err(FrustumError::UpParallelToView);
+        }
+        let right = right.normalize();
+        let world_from_view = DMat4::from_cols(
+            right.extend(0.0),
+            right.cross(fwd).extend(0.0),
+            (-fwd).extend(0.0),
+            m.w_axis.truncate().extend(1.0),
+        );
+
+        let (near, far, ray_origin, ray_dir) = match camera.projection {
+            Projection::Perspective {
+                fov_y,
+                aspect,
+                near,
+                far,
+            } => {
+                let (n, f) = (finite(near)?, finite(far)?);
+                check_range(n, f, false)?;
+                let (o, d) = symmetric_rays(fov_y, aspect)?;
+                (n, f, o, d)
+            }
+            Projection::InfinitePerspective {
+                fov_y,
+                aspect,
+                near,
+                shadow_distance,
+            } => {
+                let (n, f) = (finite(near)?, finite(shadow_distance)?);
+                check_range(n, f, false)?;
+                let (o, d) = symmetric_rays(fov_y, aspect)?;
+                (n, f, o, d)
+            }
+            Projection::Orthographic {
+                left,
+                right,
+                bottom,
+                top,
+                near,
+                far,
+            } => {
+                let (l, r, b, t) = (finite(left)?, finite(right)?, finite(bottom)?, finite(top)?);
+                let (n, f) = (finite(near)?, finite(far)?);
+                check_range(n, f, true)?;
+                if !(r > l && t > b) || (r - l) < 1e-7 * r.abs().max(l.abs()) {
+                    return Err(FrustumError::EmptyBounds);
+                }
+                if (t - b) < 1e-7 * t.abs().max(b.abs()) {
+                    return Err(FrustumError::EmptyBounds);
+                }
+                let o = [
+                    DVec3::new(l, b, 0.0),
+                    DVec3::new(r, b, 0.0),
+                    DVec3::new(r, t, 0.0),
+                    DVec3::new(l, t, 0.0),
+                ];
+                (n, f, o, [DVec3::NEG_Z; 4])
+            }
+            Projection::Custom {
+                clip_from_view,
+                shadow_distance,
+            } => Self::custom_rays(&clip_from_view, shadow_distance, camera.reversed_z)?,
+        };
+        Ok(Self {
+            world_from_view,
+            near,
+            far,
+            ray_origin,
+            ray_dir,
+        })
+    }
+
+    fn custom_rays(
+        clip_from_view: &Mat4,
+        shadow_distance: f32,
+        reversed_z: bool,
+    ) -> Result<(f64, f64, [DVec3; 4], [DVec3; 4]), FrustumError> {
+        let m = clip_from_view.as_dmat4();
+        let shadow = finite(shadow_distance)?;
+        if !m.is_finite() {
+            return Err(FrustumError::NonFinite);
+        }
+        let det = m.determinant();
+        if !det.is_finite() || det.abs() < 1e-30 {
+            return Err(FrustumError::InvalidProjection);
+        }
+        let view_from_clip = m.inverse();
+        let (z_near, z_mid, z_far) = if reversed_z {
+            (1.0, 0.5, 0.0)
+        } else {
+            (0.0, 0.5, 1.0)
+        };
+        let near_center =
+            unproject(&view_from_clip, 0.0, 0.0, z_near).ok_or(FrustumError::InvalidProjection)?;
+        let near = -near_center.z;
+        // The far plane may be at infinity (w = 0): then only the shadow distance bounds it.
+        let far_plane = unproject(&view_from_clip, 0.0, 0.0, z_far)
+            .map(|p| -p.z)
+            .filter(|d| d.is_finite() && *d > near);
+        let far = far_plane.map_or(shadow, |d| d.min(shadow));
+        check_range(near, far, true)?;
+        let mut origin = [DVec3::ZERO; 4];
+        let mut dir = [DVec3::ZERO; 4];
+        for (i, (x, y)) in NDC_XY.iter().enumerate() {
+            let a = unproject(&view_from_clip, *x, *y, z_near).ok_or(FrustumError::InvalidProjection)?;
+            let b = unproject(&view_from_clip, *x, *y, z_mid).ok_or(FrustumError::InvalidProjection)?;
+            let (da, db) = (-a.z, -b.z);
+            if !(db > da) {
+                return Err(FrustumError::InvalidProjection);
+            }
+            dir[i] = (b - a) / (db - da);
+            origin[i] = a - dir[i] * da;
+        }
+        Ok((near, far, origin, dir))
+    }
+
+    /// Clamps and checks a requested slice against the camera's range.
+    pub(crate) fn check_slice(&self, near: f32, far: f32) -> Result<(f64, f64), FrustumError> {
+        let (n, f) = (finite(near)?, finite(far)?);
+        let tol = 1e-6 * self.far.abs().max(self.near.abs()).max(1e-30);
+        let err = FrustumError::InvalidDepthRange { near, far };
+        if n < self.near - tol || f > self.far + tol {
+            return Err(err);
+        }
+        let (n, f) = (n.max(self.near), f.min(self.far));
+        check_range(n, f, true)?;
+        Ok((n, f))
+    }
+
+    /// The eight view-space corners of the slice between two depths.
+    pub(crate) fn view_corners(&self, near: f64, far: f64) -> [DVec3; 8] {
+        core::array::from_fn(|i| {
+            let d = if i < 4 { near } else { far };
+            self.ray_origin[i % 4] + self.ray_dir[i % 4] * d
+        })
+    }
+
+    /// The eight world-space corners of the slice between two depths.
+    pub(crate) fn world_corners(&self, near: f64, far: f64) -> [DVec3; 8] {
+        self.view_corners(near, far)
+            .map(|c| self.world_from_view.transform_point3(c))
+    }
+
+    pub(crate) fn slice(&self, near: f64, far: f64) -> Result<Frustum, FrustumError> {
+        let corners = self.world_corners(near, far);
+        let frustum = Frustum::from_dcorners(&corners)?;
+        Ok(frustum)
+    }
+}
+
+/// A convex frustum: eight corners and six inward planes.
+///
+/// Corners: indices 0..4 lie on the near plane and 4..8 on the far plane, each in the
+/// order bottom-left, bottom-right, top-right, top-left as seen by the camera.
+/// Planes, inward: left, right, bottom, top, near, far.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frustum {
+    /// Corners in the documented order.
+    pub corners: [Vec3; 8],
+    /// Inward planes: left, right, bottom, top, near, far.
+    pub planes: [Plane; 6],
+}
+
+/// Corner indices of each plane, counter-clockwise seen from inside.
+const PLANE_CORNERS: [[usize; 3]; 6] = [
+    [0, 3, 7], // left
+    [1, 5, 6], // right
+    [0, 4, 5], // bottom
+    [3, 2, 6], // top
+    [0, 1, 2], // near
+    [4, 7, 6], // far
+];
+
+impl Frustum {
+    /// A frustum from its corners in the documented order.
+    ///
+    /// # Errors
+    /// [`FrustumError::NonFinite`], or [`FrustumError::EmptyBounds`] when the corners
+    /// do not span a volume.
+    pub fn from_corners(corners: [Vec3; 8]) -> Result<Self, FrustumError> {
+        if !corners.iter().all(|c| c.is_finite()) {
+            return Err(FrustumError::NonFinite);
+        }
+        Self::from_dcorners(&corners.map(Vec3::as_dvec3))
+    }
+
+    pub(crate) fn from_dcorners(corners: &[DVec3; 8]) -> Result<Self, FrustumError> {
+        let planes = dplanes(corners)?;
+        let corners32 = corners.map(DVec3::as_vec3);
+        if !corners32.iter().all(|c| c.is_finite()) {
+            return Err(FrustumError::NonFinite);
+        }
+        Ok(Self {
+            corners: corners32,
+            planes: planes.map(DPlane::to_plane),
+        })
+    }
+
+    /// Planes in `f64`, recomputed from the corners for accuracy.
+    pub(crate) fn dplanes(&self) -> Result<[DPlane; 6], FrustumError> {
+        dplanes(&self.corners.map(Vec3::as_dvec3))
+    }
+
+    /// Whether `p` lies inside or on the frustum, allowing `tolerance` world units.
+    #[must_use]
+    pub fn contains(&self, p: Vec3, tolerance: f32) -> bool {
+        self.planes
+            .iter()
+            .all(|pl| pl.signed_distance(p) >= -tolerance)
+    }
+
+    /// The axis-aligned box around the corners.
+    #[must_use]
+    pub fn aabb(&self) -> Aabb {
+        let mut aabb = Aabb::new(self.corners[0], self.corners[0]);
+        for c in &self.corners[1..] {
+            aabb.min = aabb.min.min(*c);
+            aabb.max = aabb.max.max(*c);
+        }
+        aabb
+    }
+
+    /// Mean of the corners.
+    #[must_use]
+    pub fn centroid(&self) -> Vec3 {
+        self.corners
+            .iter()
+            .fold(glam::DVec3::ZERO, |s, c| s + c.as_dvec3())
+            .as_vec3()
+            / 8.0
+    }
+}
+
+fn dplanes(corners: &[DVec3; 8]) -> Result<[DPlane; 6], FrustumError> {
+    let centroid = corners.iter().fold(DVec3::ZERO, |s, c| s + *c) / 8.0;
+    let scale = corners
+        .iter()
+        .map(|c| (*c - centroid).length())
+        .fold(0.0, f64::max);
+    if !(scale > 0.0 && scale.is_finite()) {
+        return Err(FrustumError::EmptyBounds);
+    }
+    let mut planes = [DPlane {
+        normal: DVec3::Z,
+        d: 0.0,
+    }; 6];
+    for (plane, idx) in planes.iter_mut().zip(PLANE_CORNERS) {
+        let [a, b, c] = idx.map(|i| corners[i]);
+        // A face may be degenerate at one corner (e.g. a zero-size near plane); try the
+        // other triangle of the quad before giving up.
+        let p = DPlane::through(a, b, c)
+            .or_else(|| {
+                let d = corners[fourth_corner(idx)];
+                DPlane::through(a, c, d)
+            })
+            .ok_or(FrustumError::EmptyBounds)?;
+        *plane = if p.distance(centroid) < 0.0 { p.flipped() } else { p };
+        if plane.distance(centroid) < 1e-9 * scale {
+            return Err(FrustumError::EmptyBounds);
+        }
+    }
+    Ok(planes)
+}
+
+/// The fourth corner of a face, given three of them.
+fn fourth_corner(idx: [usize; 3]) -> usize {
+    const FACES: [[usize; 4]; 6] = [
+        [0, 3, 7, 4],
+        [1, 5, 6, 2],
+        [0, 4, 5, 1],
+        [3, 2, 6, 7],
+        [0, 1, 2, 3],
+        [4, 7, 6, 5],
+    ];
+    FACES
+        .iter()
+        .find(|f| f[..3] == idx)
+        .map_or(idx[0], |f| f[3])
+}

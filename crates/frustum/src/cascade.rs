@@ -1,0 +1,389 @@
+use arrayvec::ArrayVec;
+use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
+
+use crate::body::ConvexBody;
+use crate::camera::CameraGeometry;
+use crate::light::{light_from_world_rotation, unit};
+use crate::mapping::{LightDirection, ShadowSample, ShadowTransform, project_dmat};
+use crate::split::CascadeBlend;
+use crate::{Aabb, Camera, CascadeSplits, FrustumError, MAX_CASCADES, ShadowMapping, math};
+
+/// Largest accepted shadow-map resolution (texels per side).
+pub const MAX_RESOLUTION: u32 = 65536;
+
+/// Bounds of the scene for scene-dependent fitting.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneBounds {
+    /// Everything that receives shadows.
+    pub receivers: Aabb,
+    /// Everything that casts shadows.
+    pub casters: Aabb,
+}
+
+/// How a cascade's light-space rectangle is chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CascadeFit {
+    /// The light-space box of the slice (or of slice ∩ receivers): the most texels on
+    /// the slice, but the map's size and texel grid change as the camera moves or
+    /// turns, so shadow edges shimmer.
+    Tight,
+    /// The box of the slice's bounding sphere, snapped to whole texels against a fixed
+    /// world anchor: the size is invariant under camera rotation and camera motion
+    /// moves the map by whole texels, so shadow edges do not shimmer.
+    #[default]
+    Stable,
+}
+
+/// Knobs of the directional cascade fit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct CascadeOptions {
+    /// Texels per side of each cascade's map, in `4..=65536`.
+    pub resolution: u32,
+    /// Tight or stable.
+    pub fit: CascadeFit,
+    /// Reversed-Z depth (1 at the light's near plane).
+    pub reversed_z: bool,
+    /// Orients the light frame (see [`directional_light_from_world`](crate::directional_light_from_world)).
+    pub up_hint: Vec3,
+    /// Scene bounds for scene-dependent fitting.
+    pub scene: Option<SceneBounds>,
+}
+
+impl Default for CascadeOptions {
+    fn default() -> Self {
+        Self {
+            resolution: 2048,
+            fit: CascadeFit::Stable,
+            reversed_z: false,
+            up_hint: Vec3::Y,
+            scene: None,
+        }
+    }
+}
+
+impl CascadeOptions {
+    /// With this resolution.
+    #[must_use]
+    pub const fn with_resolution(mut self, resolution: u32) -> Self {
+        self.resolution = resolution;
+        self
+    }
+    /// With this fit.
+    #[must_use]
+    pub const fn with_fit(mut self, fit: CascadeFit) -> Self {
+        self.fit = fit;
+        self
+    }
+    /// With reversed-Z on or off.
+    #[must_use]
+    pub const fn with_reversed_z(mut self, reversed_z: bool) -> Self {
+        self.reversed_z = reversed_z;
+        self
+    }
+    /// With this up hint for the light frame.
+    #[must_use]
+    pub const fn with_up_hint(mut self, up_hint: Vec3) -> Self {
+        self.up_hint = up_hint;
+        self
+    }
+    /// With scene bounds (scene-dependent fit).
+    #[must_use]
+    pub const fn with_scene(mut self, scene: Option<SceneBounds>) -> Self {
+        self.scene = scene;
+        self
+    }
+}
+
+/// One fitted cascade.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cascade {
+    /// View depths `(near, far)` this cascade covers, blend band included.
+    pub view_depth: (f32, f32),
+    /// The matrices.
+    pub transform: ShadowTransform,
+    /// World size of one texel (the larger side for a non-square tight fit).
+    pub texel_world_size: f32,
+    /// Light-space distances mapped to the near and far end of the depth range.
+    pub light_depth: (f32, f32),
+    /// Light-space distance range of the casters that overlap this cascade, if scene
+    /// bounds were given. Casters nearer than `light_depth.0` cannot occur (the near
+    /// plane is pulled back to them); a renderer that instead keeps the receivers'
+    /// near plane can clamp depth ("pancaking") over this range.
+    pub caster_depth: Option<(f32, f32)>,
+    /// The scene-dependent fit found no receivers in the slice and fell back to the
+    /// whole slice.
+    pub receivers_missed: bool,
+}
+
+/// A fitted set of cascades for a directional light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CascadeSet {
+    /// One cascade per split, near to far.
+    pub cascades: ArrayVec<Cascade, MAX_CASCADES>,
+    /// The splits they were fitted to.
+    pub splits: CascadeSplits,
+    /// The camera's view transform, for selection by depth.
+    pub view_from_world: Mat4,
+    /// The resolution of each cascade.
+    pub resolution: u32,
+}
+
+impl CascadeSet {
+    /// Fits one cascade per split of `splits` for a directional light travelling along
+    /// `light_direction`.
+    ///
+    /// With scene bounds, a slice that misses the receivers falls back to the whole
+    /// slice and sets [`Cascade::receivers_missed`]; the set is still valid.
+    ///
+    /// # Errors
+    /// Any error of [`Camera::validate`]; [`FrustumError::NonFinite`] or
+    /// [`FrustumError::ZeroDirection`] for the light; [`FrustumError::InvalidResolution`];
+    /// [`FrustumError::InvalidDepthRange`] if the splits leave the camera's range;
+    /// [`FrustumError::EmptyBounds`] / [`FrustumError::NonFinite`] for bad scene bounds.
+    pub fn fit(
+        camera: &Camera,
+        light_direction: Vec3,
+        splits: &CascadeSplits,
+        options: &CascadeOptions,
+    ) -> Result<Self, FrustumError> {
+        let fitter = Fitter::new(camera, light_direction, options)?;
+        let mut cascades = ArrayVec::new();
+        for i in 0..splits.count() {
+            let (near, far) = splits
+                .cascade_range(i)
+                .ok_or(FrustumError::InvalidCascadeCount)?;
+            let cascade = match fitter.fit(near, far) {
+                Err(FrustumError::SliceOutsideScene) => {
+                    let mut c = fitter.fit_without_receivers(near, far)?;
+                    c.receivers_missed = true;
+                    c
+                }
+                other => other?,
+            };
+            cascades.push(cascade);
+        }
+        Ok(Self {
+            cascades,
+            splits: splits.clone(),
+            view_from_world: fitter.camera.world_from_view.inverse().as_mat4(),
+            resolution: options.resolution,
+        })
+    }
+
+    /// The cascade for a world point by its view depth, with the blend weight toward
+    /// the next cascade.
+    #[must_use]
+    pub fn select_by_depth(&self, world: Vec3) -> Option<CascadeBlend> {
+        let depth = -self.view_from_world.transform_point3(world).z;
+        self.splits.select(depth)
+    }
+
+    /// The first cascade whose map contains the point (`uv` in `[0, 1]²` at least
+    /// `margin_texels` from the border, depth in `[0, 1]`): selection by projection,
+    /// which uses the finest map available where cascades overlap.
+    #[must_use]
+    pub fn select_by_projection(&self, world: Vec3, margin_texels: f32) -> Option<usize> {
+        let margin = f64::from(margin_texels) / f64::from(self.resolution.max(1));
+        self.cascades.iter().position(|c| {
+            c.transform.project(world).is_some_and(|s| {
+                let inside = |x: f64| x >= margin && x <= 1.0 - margin;
+                inside(s.uv.x) && inside(s.uv.y) && (0.0..=1.0).contains(&s.depth)
+            })
+        })
+    }
+}
+
+impl ShadowMapping for CascadeSet {
+    /// Selects by view depth; the layer is the cascade index.
+    fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
+        let blend = self.select_by_depth(world.as_vec3())?;
+        let cascade = self.cascades.get(blend.index)?;
+        let mut s = project_dmat(&cascade.transform.uv_from_world.as_dmat4(), world)?;
+        s.layer = blend.index as u32;
+        Some(s)
+    }
+}
+
+/// Fits a single cascade covering view depths `[near_depth, far_depth]`.
+///
+/// # Errors
+/// As [`CascadeSet::fit`], plus [`FrustumError::SliceOutsideScene`] when scene bounds
+/// are given and the slice misses the receivers.
+pub fn fit_cascade(
+    camera: &Camera,
+    light_direction: Vec3,
+    near_depth: f32,
+    far_depth: f32,
+    options: &CascadeOptions,
+) -> Result<Cascade, FrustumError> {
+    let fitter = Fitter::new(camera, light_direction, options)?;
+    let (n, f) = fitter.camera.check_slice(near_depth, far_depth)?;
+    fitter.fit(n as f32, f as f32)
+}
+
+struct Fitter {
+    camera: CameraGeometry,
+    light_dir: DVec3,
+    light_from_world: DMat4,
+    options: CascadeOptions,
+    scene: Option<SceneBounds>,
+}
+
+impl Fitter {
+    fn new(camera: &Camera, light_direction: Vec3, options: &CascadeOptions) -> Result<Self, FrustumError> {
+        let camera = camera.geometry()?;
+        let light_dir = unit(light_direction)?;
+        if !(4..=MAX_RESOLUTION).contains(&options.resolution) {
+            return Err(FrustumError::InvalidResolution);
+        }
+        let scene = match options.scene {
+            Some(s) => Some(SceneBounds {
+                receivers: s.receivers.validate()?,
+                casters: s.casters.validate()?,
+            }),
+            None => None,
+        };
+        Ok(Self {
+            camera,
+            light_dir,
+            light_from_world: light_from_world_rotation(light_dir, options.up_hint)?,
+            options: *options,
+            scene,
+        })
+    }
+
+    fn fit_without_receivers(&self, near: f32, far: f32) -> Result<Cascade, FrustumError> {
+        let receiverless = Self {
+            scene: None,
+            ..*self
+        };
+        receiverless.fit(near, far)
+    }
+
+    fn fit(&self, near: f32, far: f32) -> Result<Cascade, FrustumError> {
+        let (n, f) = self.camera.check_slice(near, far)?;
+        let corners = self.camera.world_corners(n, f);
+        let mut points: ArrayVec<DVec3, { crate::MAX_BODY_VERTICES }> = ArrayVec::new();
+        match &self.scene {
+            Some(scene) => {
+                let slice = crate::Frustum::from_dcorners(&corners)?;
+                let body = ConvexBody::from_frustum_aabb(&slice, &scene.receivers)?;
+                if body.is_empty() {
+                    return Err(FrustumError::SliceOutsideScene);
+                }
+                points.extend(body.vertices().iter().map(|v| v.as_dvec3()));
+            }
+            None => points.extend(corners),
+        }
+        let light = &self.light_from_world;
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for p in &points {
+            let q = light.transform_point3(*p);
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+        let res = f64::from(self.options.resolution);
+        let (xy_lo, xy_hi, texel) = match self.options.fit {
+            CascadeFit::Tight => {
+                let size = (hi - lo).truncate();
+                let scale = lo.abs().max(hi.abs()).max_element().max(1e-30);
+                // A slice seen edge-on from the light is flat: give it a sliver of area.
+                let pad = (DVec2::splat(1e-6 * scale) - size).max(DVec2::ZERO) * 0.5;
+                let (a, b) = (lo.truncate() - pad, hi.truncate() + pad);
+                (a, b, (b - a).max_element() / res)
+            }
+            CascadeFit::Stable => {
+                let (center_view, radius) = bounding_sphere(&self.camera.view_corners(n, f));
+                let center = light.transform_point3(self.camera.world_from_view.transform_point3(center_view));
+                // One texel of slack on each side absorbs the snap (at most half a texel).
+                let texel = 2.0 * radius / (res - 2.0);
+                if !(texel > 0.0 && texel.is_finite()) {
+                    return Err(FrustumError::EmptyBounds);
+                }
+                let snapped = (center.truncate() / texel).round() * texel;
+                let half = DVec2::splat(0.5 * res * texel);
+                (snapped - half, snapped + half, texel)
+            }
+        };
+        // Light space looks down -Z: distance from the light is -z.
+        let mut near_dist = -hi.z;
+        let far_dist = -lo.z;
+        let mut caster_depth = None;
+        if let Some(scene) = &self.scene {
+            let c = scene.casters.transformed(&light.as_mat4());
+            let overlaps = f64::from(c.max.x) >= xy_lo.x
+                && f64::from(c.min.x) <= xy_hi.x
+                && f64::from(c.max.y) >= xy_lo.y
+                && f64::from(c.min.y) <= xy_hi.y;
+            if overlaps {
+                let (c_near, c_far) = (-f64::from(c.max.z), -f64::from(c.min.z));
+                caster_depth = Some((c_near as f32, c_far as f32));
+                near_dist = near_dist.min(c_near);
+            }
+        }
+        let depth_scale = near_dist.abs().max(far_dist.abs()).max(1e-30);
+        let min_thickness = 1e-5 * depth_scale;
+        let (near_dist, far_dist) = if far_dist - near_dist < min_thickness {
+            let mid = 0.5 * (near_dist + far_dist);
+            (mid - min_thickness, mid + min_thickness)
+        } else {
+            (near_dist, far_dist)
+        };
+        let clip_from_light = crate::projection::orthographic(
+            xy_lo.x,
+            xy_hi.x,
+            xy_lo.y,
+            xy_hi.y,
+            near_dist,
+            far_dist,
+            self.options.reversed_z,
+        );
+        let clip_from_world = (clip_from_light * *light).as_mat4();
+        if !clip_from_world.is_finite() || clip_from_world.determinant() == 0.0 {
+            return Err(FrustumError::EmptyBounds);
+        }
+        let transform = ShadowTransform::new(
+            light.as_mat4(),
+            clip_from_world,
+            self.options.reversed_z,
+            LightDirection::Directional(self.light_dir.as_vec3()),
+        );
+        Ok(Cascade {
+            view_depth: (n as f32, f as f32),
+            transform,
+            texel_world_size: texel as f32,
+            light_depth: (near_dist as f32, far_dist as f32),
+            caster_depth,
+            receivers_missed: false,
+        })
+    }
+}
+
+/// A bounding sphere of a slice from its view-space corners. It depends only on the
+/// projection and the depths, never on the camera's pose, so its radius is exactly
+/// invariant under camera rotation. The centre lies on the segment between the near
+/// and far face centroids, where the minimal sphere of a symmetric slice lies; the
+/// radius is the farthest corner, so the sphere encloses any slice.
+pub(crate) fn bounding_sphere(corners: &[DVec3; 8]) -> (DVec3, f64) {
+    let near_c = (corners[0] + corners[1] + corners[2] + corners[3]) * 0.25;
+    let far_c = (corners[4] + corners[5] + corners[6] + corners[7]) * 0.25;
+    let radius_at = |t: f64| {
+        let c = near_c.lerp(far_c, t);
+        corners.iter().map(|p| p.distance_squared(c)).fold(0.0, f64::max)
+    };
+    // The farthest-corner distance is convex along the segment: ternary search.
+    let (mut a, mut b) = (0.0f64, 1.0f64);
+    for _ in 0..80 {
+        let m1 = a + (b - a) / 3.0;
+        let m2 = b - (b - a) / 3.0;
+        if radius_at(m1) <= radius_at(m2) {
+            b = m2;
+        } else {
+            a = m1;
+        }
+    }
+    let t = 0.5 * (a + b);
+    (near_c.lerp(far_c, t), math::sqrt(radius_at(t)))
+}

@@ -1,0 +1,103 @@
+//! Cameras, frustum slices, cascade splits and cascade fitting for shadow maps.
+//!
+//! This crate is the shared vocabulary of `shadowmap`: [`Aabb`], [`Plane`],
+//! [`Sphere`], [`Camera`] with its [`Projection`], [`Light`], [`Frustum`] and
+//! [`ConvexBody`]; the output type of matrix techniques, [`ShadowTransform`]; and the
+//! one trait every technique implements, [`ShadowMapping`]. On top of it, it fits
+//! parallel-split (cascaded) shadow maps for directional lights:
+//!
+//! - split schemes ([`SplitScheme`]): uniform, logarithmic, practical (lambda) and
+//!   custom, with a blend band between cascades ([`CascadeSplits`]);
+//! - fits ([`CascadeFit`]): tight, scene-dependent (slice ∩ receivers, near plane
+//!   pulled back to the casters) and stable (rotation-invariant size, whole-texel
+//!   motion);
+//! - depth bounds from a min/max depth reduction ([`CascadeSplits::from_depth_bounds`],
+//!   the "sample distribution" of SDSM and the truncated frustum of IPSM);
+//! - cascade selection by view depth and by projection;
+//! - a perspective fit for spot lights ([`fit_spot`]).
+//!
+//! The algorithms follow Zhang et al., *Parallel-Split Shadow Maps* (2006) and the PSSM
+//! thesis in `shared/seeds`.
+//!
+//! # Example
+//!
+//! ```
+//! use glam::Vec3;
+//! use shadowmap_frustum::{Camera, CascadeOptions, CascadeSet, CascadeSplits, Projection, SplitScheme};
+//!
+//! let camera = Camera::look_to(
+//!     Vec3::new(0.0, 2.0, 0.0),
+//!     Vec3::NEG_Z,
+//!     Vec3::Y,
+//!     Projection::perspective(60f32.to_radians(), 16.0 / 9.0, 0.1, 200.0),
+//! )?;
+//! let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.5 }, 4, 0.1, 200.0)?
+//!     .with_overlap(0.1)?;
+//! let set = CascadeSet::fit(&camera, Vec3::new(-1.0, -2.0, -0.5), &splits, &CascadeOptions::default())?;
+//! assert_eq!(set.cascades.len(), 4);
+//!
+//! // A point in view lands inside its cascade's map.
+//! let p = Vec3::new(1.0, 0.0, -30.0);
+//! let blend = set.select_by_depth(p).unwrap();
+//! let sample = set.cascades[blend.index].transform.project(p).unwrap();
+//! assert!((0.0..=1.0).contains(&sample.uv.x) && (0.0..=1.0).contains(&sample.depth));
+//! # Ok::<(), shadowmap_frustum::FrustumError>(())
+//! ```
+//!
+//! # Conventions
+//!
+//! | what | convention |
+//! |---|---|
+//! | handedness | right-handed world, y up |
+//! | view space | looks down `-Z`; view depth = `-z_view` |
+//! | light space | looks down `-Z` along the light; light distance = `-z_light` |
+//! | clip space | WebGPU: x, y in `[-1, 1]`, depth in `[0, 1]` |
+//! | reversed-Z | an option of every builder: depth 1 at the near plane |
+//! | texture space | `u = x/2 + 1/2`, `v = 1/2 - y/2` (`v` down), see [`UV_FROM_CLIP`] |
+//! | matrix names | destination-from-source: `clip_from_world`, `uv_from_world` |
+//! | precision | public API in `f32`; builders compute in `f64` and convert |
+//! | frustum corners | near then far; each bottom-left, bottom-right, top-right, top-left |
+//! | frustum planes | inward normals: left, right, bottom, top, near, far |
+//!
+//! # Bad input
+//!
+//! Every builder returns a [`FrustumError`] for input it cannot honour, and documents
+//! which; none panics or returns a NaN or singular matrix. Documented fallbacks:
+//! a light parallel to the up hint uses another axis to orient the light frame
+//! ([`directional_light_from_world`]); a cascade whose slice misses the receivers is
+//! fitted to the whole slice ([`Cascade::receivers_missed`]).
+//!
+//! # Features
+//!
+//! `std` (default) or `libm`: one of them provides float math; with `libm` and without
+//! `std` the crate is `no_std`. No builder allocates on the heap.
+
+#![cfg_attr(not(feature = "std"), no_std)]
+
+mod body;
+mod camera;
+mod cascade;
+mod depth_bounds;
+mod error;
+mod geometry;
+mod light;
+mod mapping;
+pub mod math;
+pub mod projection;
+mod split;
+mod spot;
+
+pub use body::{ConvexBody, MAX_BODY_VERTICES};
+pub use camera::{Camera, Frustum, Projection};
+pub use cascade::{
+    Cascade, CascadeFit, CascadeOptions, CascadeSet, MAX_RESOLUTION, SceneBounds, fit_cascade,
+};
+pub use depth_bounds::DepthBounds;
+pub use error::FrustumError;
+pub use geometry::{Aabb, Plane, Sphere};
+pub use light::{Light, directional_light_from_world};
+pub use mapping::{LightDirection, ShadowMapping, ShadowSample, ShadowTransform, UV_FROM_CLIP};
+pub use split::{CascadeBlend, CascadeSplits, MAX_CASCADES, SplitScheme};
+pub use spot::{SpotShadow, fit_spot};
+
+pub use glam;

@@ -1,0 +1,132 @@
+use glam::{DMat4, DVec3, Vec3};
+
+use crate::FrustumError;
+
+/// A light source.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// Parallel rays, e.g. the sun.
+    Directional {
+        /// Direction the light travels (from the light toward the scene).
+        direction: Vec3,
+    },
+    /// A cone of light.
+    Spot {
+        /// World position.
+        position: Vec3,
+        /// Axis of the cone, the direction the light travels.
+        direction: Vec3,
+        /// Half-angle of the cone in radians, in `(0, pi/2)`.
+        half_angle: f32,
+        /// Distance beyond which the light has no effect, positive.
+        range: f32,
+    },
+    /// Light in every direction.
+    Point {
+        /// World position.
+        position: Vec3,
+        /// Distance beyond which the light has no effect, positive.
+        range: f32,
+    },
+}
+
+impl Light {
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`FrustumError::NonFinite`], [`FrustumError::ZeroDirection`],
+    /// [`FrustumError::InvalidLight`] for a spot angle outside `(0, pi/2)` or a range
+    /// that is not positive.
+    pub fn validate(&self) -> Result<(), FrustumError> {
+        match *self {
+            Self::Directional { direction } => unit(direction).map(|_| ()),
+            Self::Spot {
+                position,
+                direction,
+                half_angle,
+                range,
+            } => {
+                if !(position.is_finite() && half_angle.is_finite() && range.is_finite()) {
+                    return Err(FrustumError::NonFinite);
+                }
+                unit(direction)?;
+                let max = core::f32::consts::FRAC_PI_2 - 1e-4;
+                if !(half_angle > 1e-5 && half_angle < max && range > 0.0) {
+                    return Err(FrustumError::InvalidLight);
+                }
+                Ok(())
+            }
+            Self::Point { position, range } => {
+                if !(position.is_finite() && range.is_finite()) {
+                    return Err(FrustumError::NonFinite);
+                }
+                if range > 0.0 {
+                    Ok(())
+                } else {
+                    Err(FrustumError::InvalidLight)
+                }
+            }
+        }
+    }
+}
+
+/// The unit vector along `v` in `f64`.
+pub(crate) fn unit(v: Vec3) -> Result<DVec3, FrustumError> {
+    if !v.is_finite() {
+        return Err(FrustumError::NonFinite);
+    }
+    v.as_dvec3()
+        .try_normalize()
+        .filter(|u| u.length_squared() > 0.5)
+        .ok_or(FrustumError::ZeroDirection)
+}
+
+/// Rotation-only light frame looking along `direction` (light space looks down `-Z`).
+///
+/// `up_hint` orients the frame; when it is (nearly) parallel to the light, the world
+/// axis least aligned with the light is used instead. This is the documented fallback
+/// for "light parallel to the up vector": the frame stays well defined and depends
+/// only on the light, so stable cascades stay stable.
+///
+/// # Errors
+/// [`FrustumError::NonFinite`], [`FrustumError::ZeroDirection`].
+pub fn directional_light_from_world(direction: Vec3, up_hint: Vec3) -> Result<glam::Mat4, FrustumError> {
+    light_from_world_rotation(unit(direction)?, up_hint).map(|m| m.as_mat4())
+}
+
+pub(crate) fn light_from_world_rotation(dir: DVec3, up_hint: Vec3) -> Result<DMat4, FrustumError> {
+    let up = if up_hint.is_finite() {
+        up_hint.as_dvec3().try_normalize()
+    } else {
+        None
+    };
+    let up = match up {
+        Some(u) if dir.cross(u).length() > 1e-3 => u,
+        _ => least_aligned_axis(dir),
+    };
+    Ok(look_to_rh(DVec3::ZERO, dir, up))
+}
+
+pub(crate) fn least_aligned_axis(dir: DVec3) -> DVec3 {
+    let a = dir.abs();
+    if a.x <= a.y && a.x <= a.z {
+        DVec3::X
+    } else if a.y <= a.z {
+        DVec3::Y
+    } else {
+        DVec3::Z
+    }
+}
+
+/// `view_from_world` looking from `eye` along unit `dir`, `up` not parallel to `dir`.
+pub(crate) fn look_to_rh(eye: DVec3, dir: DVec3, up: DVec3) -> DMat4 {
+    let f = dir;
+    let s = f.cross(up).normalize();
+    let u = s.cross(f);
+    DMat4::from_cols(
+        glam::DVec4::new(s.x, u.x, -f.x, 0.0),
+        glam::DVec4::new(s.y, u.y, -f.y, 0.0),
+        glam::DVec4::new(s.z, u.z, -f.z, 0.0),
+        glam::DVec4::new(-eye.dot(s), -eye.dot(u), eye.dot(f), 1.0),
+    )
+}

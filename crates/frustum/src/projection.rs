@@ -1,0 +1,76 @@
+//! Projection matrices in `f64`, WebGPU clip space (depth in `[0, 1]`), right-handed
+//! (the eye looks down `-Z`), each with a reversed-Z option.
+//!
+//! With `d = -z` the distance in front of the eye:
+//!
+//! ```text
+//! orthographic   x_ndc = (2x - (r + l)) / (r - l)        depth = (d - n) / (f - n)
+//! perspective    x_ndc = (2x/d - (r + l)) / (r - l)      depth = f (d - n) / (d (f - n))
+//! ```
+//!
+//! For perspective `l, r, b, t` are tangents of the side planes (`x/d` at the edges).
+//! Reversed-Z swaps the roles of `n` and `f` in the depth row, giving depth 1 at the
+//! near plane and 0 at the far plane.
+
+use glam::{DMat4, DVec4};
+
+use crate::math;
+
+/// Orthographic projection of the box `[l, r] x [b, t]` between distances `near` and
+/// `far` (`near != far`; either may be negative).
+#[must_use]
+pub fn orthographic(l: f64, r: f64, b: f64, t: f64, near: f64, far: f64, reversed_z: bool) -> DMat4 {
+    let (n, f) = if reversed_z { (far, near) } else { (near, far) };
+    let rcp = 1.0 / (n - f);
+    DMat4::from_cols(
+        DVec4::new(2.0 / (r - l), 0.0, 0.0, 0.0),
+        DVec4::new(0.0, 2.0 / (t - b), 0.0, 0.0),
+        DVec4::new(0.0, 0.0, rcp, 0.0),
+        DVec4::new(-(r + l) / (r - l), -(t + b) / (t - b), rcp * n, 1.0),
+    )
+}
+
+/// Off-centre perspective from the tangents of the side planes, between distances
+/// `0 < near < far`.
+#[must_use]
+pub fn perspective_off_center(
+    l: f64,
+    r: f64,
+    b: f64,
+    t: f64,
+    near: f64,
+    far: f64,
+    reversed_z: bool,
+) -> DMat4 {
+    let (n, f) = if reversed_z { (far, near) } else { (near, far) };
+    let a = f / (n - f);
+    DMat4::from_cols(
+        DVec4::new(2.0 / (r - l), 0.0, 0.0, 0.0),
+        DVec4::new(0.0, 2.0 / (t - b), 0.0, 0.0),
+        DVec4::new((r + l) / (r - l), (t + b) / (t - b), a, -1.0),
+        DVec4::new(0.0, 0.0, a * n, 0.0),
+    )
+}
+
+/// Symmetric perspective from a vertical field of view and aspect ratio.
+#[must_use]
+pub fn perspective(fov_y: f64, aspect: f64, near: f64, far: f64, reversed_z: bool) -> DMat4 {
+    let ty = math::tan(0.5 * fov_y);
+    let tx = ty * aspect;
+    perspective_off_center(-tx, tx, -ty, ty, near, far, reversed_z)
+}
+
+/// Symmetric perspective with the far plane at infinity.
+#[must_use]
+pub fn perspective_infinite(fov_y: f64, aspect: f64, near: f64, reversed_z: bool) -> DMat4 {
+    let ty = math::tan(0.5 * fov_y);
+    let tx = ty * aspect;
+    // Limits of the depth row of `perspective` as far -> infinity.
+    let (a, b) = if reversed_z { (0.0, near) } else { (-1.0, -near) };
+    DMat4::from_cols(
+        DVec4::new(1.0 / tx, 0.0, 0.0, 0.0),
+        DVec4::new(0.0, 1.0 / ty, 0.0, 0.0),
+        DVec4::new(0.0, 0.0, a, -1.0),
+        DVec4::new(0.0, 0.0, b, 0.0),
+    )
+}
