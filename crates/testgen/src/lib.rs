@@ -19,6 +19,11 @@ use shadowmap_frustum::{Aabb, Camera, Projection, SplitScheme, projection};
 
 pub use arbitrary;
 
+pub mod frustum;
+pub mod paraboloid;
+pub mod rtw;
+pub mod warp;
+
 /// Result of a generator.
 pub type GenResult<T> = arbitrary::Result<T>;
 

@@ -1,0 +1,1 @@
+//! Generators and checks for `shadowmap-frustum` (fuzz targets and property tests).

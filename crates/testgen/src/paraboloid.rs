@@ -1,0 +1,1 @@
+//! Generators and checks for `shadowmap-paraboloid` (fuzz targets and property tests).

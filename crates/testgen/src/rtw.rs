@@ -1,0 +1,1 @@
+//! Generators and checks for `shadowmap-rtw` (fuzz targets and property tests).

@@ -1,0 +1,1 @@
+//! Generators and checks for `shadowmap-warp` (fuzz targets and property tests).
