@@ -29,15 +29,33 @@ impl ConvexBody {
     /// [`FrustumError::NonFinite`], [`FrustumError::EmptyBounds`] for an inverted box
     /// or a frustum without volume.
     pub fn from_frustum_aabb(frustum: &Frustum, aabb: &Aabb) -> Result<Self, FrustumError> {
+        Self::from_planes_aabb(&frustum.dplanes()?, &frustum.corners, aabb)
+    }
+
+    /// The body from a frustum's exact `f64` corners (the builders' path: no `f32`
+    /// rounding of the corners before clipping).
+    pub(crate) fn from_dcorners_aabb(
+        corners: &[DVec3; 8],
+        aabb: &Aabb,
+    ) -> Result<Self, FrustumError> {
+        let planes = crate::camera::dplanes(corners, 0.0)?;
+        Self::from_planes_aabb(&planes, &corners.map(DVec3::as_vec3), aabb)
+    }
+
+    /// `planes ∩ aabb` for any six planes bounding a convex region; `corners` set the
+    /// rounding scale.
+    pub(crate) fn from_planes_aabb(
+        fplanes: &[DPlane; 6],
+        corners: &[Vec3; 8],
+        aabb: &Aabb,
+    ) -> Result<Self, FrustumError> {
         let aabb = aabb.validate()?;
-        let fplanes = frustum.dplanes()?;
         let mut planes = [fplanes[0]; 12];
-        planes[..6].copy_from_slice(&fplanes);
+        planes[..6].copy_from_slice(fplanes);
         for (dst, p) in planes[6..].iter_mut().zip(aabb.planes()) {
             *dst = DPlane::from_plane(&p);
         }
-        let scale = frustum
-            .corners
+        let scale = corners
             .iter()
             .chain(&aabb.corners())
             .map(|c| c.abs().max_element())
@@ -47,8 +65,10 @@ impl ConvexBody {
             vertices: ArrayVec::new(),
         };
         let scale = f64::from(scale);
-        let inside_tol = 1e-9 * scale;
-        let merge_tol = 1e-7 * scale;
+        // The corners are f32, so a frustum face is planar only to about f32 epsilon
+        // times the scale: accept vertices that far outside, and merge closer ones.
+        let inside_tol = 8.0 * f64::from(f32::EPSILON) * scale;
+        let merge_tol = 2.0 * inside_tol;
         for i in 0..12 {
             for j in i + 1..12 {
                 for k in j + 1..12 {

@@ -138,15 +138,20 @@ impl Camera {
     /// degenerate pose, [`FrustumError::InvalidFov`], [`FrustumError::InvalidAspect`],
     /// [`FrustumError::InvalidDepthRange`] (near <= 0 for perspective, far <= near, or
     /// a range too thin for `f32`), [`FrustumError::InvalidProjection`] for a custom
-    /// matrix that is singular or does not look down `-Z`.
+    /// matrix that is singular or does not look down `-Z`,
+    /// [`FrustumError::DegenerateFrustum`] for a frustum with no volume at `f32`
+    /// precision or with a corner farther than 1e15 from the origin.
     pub fn validate(&self) -> Result<(), FrustumError> {
-        self.geometry().map(|_| ())
+        self.clip_from_world().map(|_| ())
     }
 
-    /// Transform from world space to view space.
-    #[must_use]
-    pub fn view_from_world(&self) -> Mat4 {
-        self.world_from_view.inverse()
+    /// Transform from world space to view space: the inverse of the pose after
+    /// re-orthonormalization (so a slightly non-rigid pose still gives a rigid inverse).
+    ///
+    /// # Errors
+    /// As [`Camera::validate`].
+    pub fn view_from_world(&self) -> Result<Mat4, FrustumError> {
+        Ok(self.geometry()?.world_from_view.inverse().as_mat4())
     }
 
     /// Camera position in world space.
@@ -237,7 +242,22 @@ impl Camera {
     /// # Errors
     /// As [`Camera::validate`].
     pub fn clip_from_world(&self) -> Result<Mat4, FrustumError> {
-        Ok(self.clip_from_view()? * self.view_from_world())
+        let view_from_world = self.geometry()?.world_from_view.inverse();
+        let clip_from_view = self.clip_from_view()?.as_dmat4();
+        let m = (clip_from_view * view_from_world).as_mat4();
+        // Far from the origin with a tiny near plane, f32 cannot tell the depth row
+        // from the w row.
+        let g = self.geometry()?;
+        let reach = g
+            .world_corners(g.near, g.far)
+            .iter()
+            .map(|c| c.abs().max_element())
+            .fold(0.0, f64::max);
+        if crate::is_invertible(&m, reach as f32) {
+            Ok(m)
+        } else {
+            Err(FrustumError::DegenerateFrustum)
+        }
     }
 
     /// The frustum between the near plane and the far plane (or shadow distance).
@@ -347,6 +367,21 @@ fn symmetric_rays(fov_y: f32, aspect: f32) -> Result<([DVec3; 4], [DVec3; 4]), F
     Ok(([DVec3::ZERO; 4], dir))
 }
 
+/// Largest accepted world coordinate of a frustum corner: squared distances must stay
+/// finite in `f32`.
+const MAX_COORDINATE: f64 = 1e15;
+
+/// Smallest accepted distance of an `f32` frustum's centroid from any of its faces:
+/// 1024 ulps of its largest coordinate, so that rounding the corners turns no face
+/// plane by more than about a milliradian.
+fn f32_min_distance(corners: &[DVec3; 8]) -> f64 {
+    let max = corners
+        .iter()
+        .map(|c| c.abs().max_element())
+        .fold(0.0, f64::max);
+    1024.0 * f64::from(f32::EPSILON) * max
+}
+
 const NDC_XY: [(f64, f64); 4] = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
 
 fn unproject(view_from_clip: &DMat4, x: f64, y: f64, z: f64) -> Option<DVec3> {
@@ -430,13 +465,29 @@ impl CameraGeometry {
                 shadow_distance,
             } => Self::custom_rays(&clip_from_view, shadow_distance, camera.reversed_z)?,
         };
-        Ok(Self {
+        let geometry = Self {
             world_from_view,
             near,
             far,
             ray_origin,
             ray_dir,
-        })
+        };
+        // The frustum must keep its volume once its corners are rounded to f32.
+        let corners = geometry.world_corners(near, far);
+        if !corners.iter().all(|c| c.as_vec3().is_finite()) {
+            return Err(FrustumError::NonFinite);
+        }
+        if corners
+            .iter()
+            .any(|c| c.abs().max_element() > MAX_COORDINATE)
+        {
+            return Err(FrustumError::DegenerateFrustum);
+        }
+        let rounded = corners.map(|c| c.as_vec3().as_dvec3());
+        dplanes(&rounded, f32_min_distance(&rounded))?;
+        // ...and every builder's own construction of it must succeed too.
+        Frustum::from_dcorners(&corners)?;
+        Ok(geometry)
     }
 
     fn custom_rays(
@@ -467,18 +518,48 @@ impl CameraGeometry {
             .map(|p| -p.z)
             .filter(|d| d.is_finite() && *d > near);
         let far = far_plane.map_or(shadow, |d| d.min(shadow));
-        check_range(near, far, true)?;
+        // The depth range must lie in front of the eye (use `Orthographic` for a box
+        // that reaches behind it).
+        check_range(near, far, false)?;
         let mut origin = [DVec3::ZERO; 4];
         let mut dir = [DVec3::ZERO; 4];
         for (i, (x, y)) in NDC_XY.iter().enumerate() {
-            let a = unproject(&view_from_clip, *x, *y, z_near).ok_or(FrustumError::InvalidProjection)?;
-            let b = unproject(&view_from_clip, *x, *y, z_mid).ok_or(FrustumError::InvalidProjection)?;
+            let a = unproject(&view_from_clip, *x, *y, z_near)
+                .ok_or(FrustumError::InvalidProjection)?;
+            let b =
+                unproject(&view_from_clip, *x, *y, z_mid).ok_or(FrustumError::InvalidProjection)?;
             let (da, db) = (-a.z, -b.z);
             if !(db > da) {
                 return Err(FrustumError::InvalidProjection);
             }
             dir[i] = (b - a) / (db - da);
             origin[i] = a - dir[i] * da;
+        }
+        // Every slice face must be a convex quad with one winding (either, so mirrored
+        // projections are fine) all the way from near to far: a matrix that mixes x or
+        // y into w can twist it. A vertex's turn is quadratic in depth, so its sign is
+        // checked at both ends and at its extremum.
+        let turn = |i: usize, d: f64| {
+            let q = |k: usize| (origin[k % 4] + dir[k % 4] * d).truncate();
+            (q(i + 1) - q(i)).perp_dot(q(i + 2) - q(i + 1))
+        };
+        let sign = turn(0, near).signum();
+        let mid = 0.5 * (near + far);
+        for i in 0..4 {
+            let (t0, t1, t2) = (turn(i, near), turn(i, mid), turn(i, far));
+            // t(d) = a x^2 + b x + c with x = (d - mid) / (far - mid).
+            let a = 0.5 * (t0 + t2) - t1;
+            let b = 0.5 * (t2 - t0);
+            if sign == 0.0 || [t0, t1, t2].iter().any(|t| t * sign <= 0.0) {
+                return Err(FrustumError::InvalidProjection);
+            }
+            // For a pinhole or affine projection the turn is k (d - d_c)^2 or constant:
+            // an extremum inside the range means the centre of projection lies between
+            // near and far, where the slice collapses to a point.
+            let size = t0.abs().max(t1.abs()).max(t2.abs());
+            if a.abs() > 1e-9 * size && (b / (2.0 * a)).abs() < 1.0 {
+                return Err(FrustumError::InvalidProjection);
+            }
         }
         Ok((near, far, origin, dir))
     }
@@ -530,31 +611,24 @@ pub struct Frustum {
     pub planes: [Plane; 6],
 }
 
-/// Corner indices of each plane, counter-clockwise seen from inside.
-const PLANE_CORNERS: [[usize; 3]; 6] = [
-    [0, 3, 7], // left
-    [1, 5, 6], // right
-    [0, 4, 5], // bottom
-    [3, 2, 6], // top
-    [0, 1, 2], // near
-    [4, 7, 6], // far
-];
-
 impl Frustum {
     /// A frustum from its corners in the documented order.
     ///
     /// # Errors
-    /// [`FrustumError::NonFinite`], or [`FrustumError::EmptyBounds`] when the corners
-    /// do not span a volume.
+    /// [`FrustumError::NonFinite`], or [`FrustumError::DegenerateFrustum`] when the
+    /// corners do not span a volume.
     pub fn from_corners(corners: [Vec3; 8]) -> Result<Self, FrustumError> {
         if !corners.iter().all(|c| c.is_finite()) {
             return Err(FrustumError::NonFinite);
         }
-        Self::from_dcorners(&corners.map(Vec3::as_dvec3))
+        let dcorners = corners.map(Vec3::as_dvec3);
+        dplanes(&dcorners, f32_min_distance(&dcorners))?;
+        Self::from_dcorners(&dcorners)
     }
 
     pub(crate) fn from_dcorners(corners: &[DVec3; 8]) -> Result<Self, FrustumError> {
-        let planes = dplanes(corners)?;
+        // Exact f64 corners from a validated camera: thin slices are fine.
+        let planes = dplanes(corners, 0.0)?;
         let corners32 = corners.map(DVec3::as_vec3);
         if !corners32.iter().all(|c| c.is_finite()) {
             return Err(FrustumError::NonFinite);
@@ -566,8 +640,16 @@ impl Frustum {
     }
 
     /// Planes in `f64`, recomputed from the corners for accuracy.
+    /// The stored planes in `f64`: the same planes [`Frustum::contains`] uses.
     pub(crate) fn dplanes(&self) -> Result<[DPlane; 6], FrustumError> {
-        dplanes(&self.corners.map(Vec3::as_dvec3))
+        let mut planes = [DPlane::from_plane(&self.planes[0]); 6];
+        for (dst, p) in planes.iter_mut().zip(&self.planes) {
+            if !(p.normal.is_finite() && p.d.is_finite() && p.normal.length() > 0.5) {
+                return Err(FrustumError::DegenerateFrustum);
+            }
+            *dst = DPlane::from_plane(p);
+        }
+        Ok(planes)
     }
 
     /// Whether `p` lies inside or on the frustum, allowing `tolerance` world units.
@@ -600,49 +682,64 @@ impl Frustum {
     }
 }
 
-fn dplanes(corners: &[DVec3; 8]) -> Result<[DPlane; 6], FrustumError> {
+/// Inward planes of a frustum's faces. `min_distance` is the smallest accepted
+/// distance of the centroid from a face.
+pub(crate) fn dplanes(
+    corners: &[DVec3; 8],
+    min_distance: f64,
+) -> Result<[DPlane; 6], FrustumError> {
     let centroid = corners.iter().fold(DVec3::ZERO, |s, c| s + *c) / 8.0;
     let scale = corners
         .iter()
         .map(|c| (*c - centroid).length())
         .fold(0.0, f64::max);
     if !(scale > 0.0 && scale.is_finite()) {
-        return Err(FrustumError::EmptyBounds);
+        return Err(FrustumError::DegenerateFrustum);
     }
     let mut planes = [DPlane {
         normal: DVec3::Z,
         d: 0.0,
     }; 6];
-    for (plane, idx) in planes.iter_mut().zip(PLANE_CORNERS) {
-        let [a, b, c] = idx.map(|i| corners[i]);
-        // A face may be degenerate at one corner (e.g. a zero-size near plane); try the
-        // other triangle of the quad before giving up.
-        let p = DPlane::through(a, b, c)
-            .or_else(|| {
-                let d = corners[fourth_corner(idx)];
-                DPlane::through(a, c, d)
-            })
-            .ok_or(FrustumError::EmptyBounds)?;
-        *plane = if p.distance(centroid) < 0.0 { p.flipped() } else { p };
-        if plane.distance(centroid) < 1e-9 * scale {
-            return Err(FrustumError::EmptyBounds);
+    for (plane, face) in planes.iter_mut().zip(FACES) {
+        let quad = face.map(|i| corners[i]);
+        // Newell's normal uses all four corners, so a face with one tiny edge (the near
+        // face of a frustum with a small near distance) is as well conditioned as its
+        // long edges allow; the plane passes through the corners' mean.
+        let mut normal = DVec3::ZERO;
+        for k in 0..4 {
+            let (a, b) = (quad[k], quad[(k + 1) % 4]);
+            normal += DVec3::new(
+                (a.y - b.y) * (a.z + b.z),
+                (a.z - b.z) * (a.x + b.x),
+                (a.x - b.x) * (a.y + b.y),
+            );
+        }
+        let normal = normal
+            .try_normalize()
+            .ok_or(FrustumError::DegenerateFrustum)?;
+        let mean = (quad[0] + quad[1] + quad[2] + quad[3]) * 0.25;
+        let p = DPlane {
+            normal,
+            d: -normal.dot(mean),
+        };
+        *plane = if p.distance(centroid) < 0.0 {
+            p.flipped()
+        } else {
+            p
+        };
+        if plane.distance(centroid) <= min_distance {
+            return Err(FrustumError::DegenerateFrustum);
         }
     }
     Ok(planes)
 }
 
-/// The fourth corner of a face, given three of them.
-fn fourth_corner(idx: [usize; 3]) -> usize {
-    const FACES: [[usize; 4]; 6] = [
-        [0, 3, 7, 4],
-        [1, 5, 6, 2],
-        [0, 4, 5, 1],
-        [3, 2, 6, 7],
-        [0, 1, 2, 3],
-        [4, 7, 6, 5],
-    ];
-    FACES
-        .iter()
-        .find(|f| f[..3] == idx)
-        .map_or(idx[0], |f| f[3])
-}
+/// Corner indices of each face (left, right, bottom, top, near, far), in order around it.
+const FACES: [[usize; 4]; 6] = [
+    [0, 3, 7, 4],
+    [1, 5, 6, 2],
+    [0, 4, 5, 1],
+    [3, 2, 6, 7],
+    [0, 1, 2, 3],
+    [4, 7, 6, 5],
+];

@@ -231,7 +231,11 @@ struct Fitter {
 }
 
 impl Fitter {
-    fn new(camera: &Camera, light_direction: Vec3, options: &CascadeOptions) -> Result<Self, FrustumError> {
+    fn new(
+        camera: &Camera,
+        light_direction: Vec3,
+        options: &CascadeOptions,
+    ) -> Result<Self, FrustumError> {
         let camera = camera.geometry()?;
         let light_dir = unit(light_direction)?;
         if !(4..=MAX_RESOLUTION).contains(&options.resolution) {
@@ -267,8 +271,14 @@ impl Fitter {
         let mut points: ArrayVec<DVec3, { crate::MAX_BODY_VERTICES }> = ArrayVec::new();
         match &self.scene {
             Some(scene) => {
-                let slice = crate::Frustum::from_dcorners(&corners)?;
-                let body = ConvexBody::from_frustum_aabb(&slice, &scene.receivers)?;
+                // A slice too thin to clip reliably is treated like one that misses
+                // the receivers: the caller falls back to the whole slice.
+                let body = ConvexBody::from_dcorners_aabb(&corners, &scene.receivers).map_err(
+                    |e| match e {
+                        FrustumError::DegenerateFrustum => FrustumError::SliceOutsideScene,
+                        e => e,
+                    },
+                )?;
                 if body.is_empty() {
                     return Err(FrustumError::SliceOutsideScene);
                 }
@@ -296,7 +306,8 @@ impl Fitter {
             }
             CascadeFit::Stable => {
                 let (center_view, radius) = bounding_sphere(&self.camera.view_corners(n, f));
-                let center = light.transform_point3(self.camera.world_from_view.transform_point3(center_view));
+                let center = light
+                    .transform_point3(self.camera.world_from_view.transform_point3(center_view));
                 // One texel of slack on each side absorbs the snap (at most half a texel).
                 let texel = 2.0 * radius / (res - 2.0);
                 if !(texel > 0.0 && texel.is_finite()) {
@@ -312,13 +323,7 @@ impl Fitter {
         let far_dist = -lo.z;
         let mut caster_depth = None;
         if let Some(scene) = &self.scene {
-            let c = scene.casters.transformed(&light.as_mat4());
-            let overlaps = f64::from(c.max.x) >= xy_lo.x
-                && f64::from(c.min.x) <= xy_hi.x
-                && f64::from(c.max.y) >= xy_lo.y
-                && f64::from(c.min.y) <= xy_hi.y;
-            if overlaps {
-                let (c_near, c_far) = (-f64::from(c.max.z), -f64::from(c.min.z));
+            if let Some((c_near, c_far)) = caster_depth_over(light, &scene.casters, xy_lo, xy_hi)? {
                 caster_depth = Some((c_near as f32, c_far as f32));
                 near_dist = near_dist.min(c_near);
             }
@@ -341,8 +346,12 @@ impl Fitter {
             self.options.reversed_z,
         );
         let clip_from_world = (clip_from_light * *light).as_mat4();
-        if !clip_from_world.is_finite() || clip_from_world.determinant() == 0.0 {
-            return Err(FrustumError::EmptyBounds);
+        let reach = points
+            .iter()
+            .map(|p| p.abs().max_element())
+            .fold(depth_scale, f64::max);
+        if !crate::is_invertible(&clip_from_world, reach as f32) {
+            return Err(FrustumError::DegenerateFrustum);
         }
         let transform = ShadowTransform::new(
             light.as_mat4(),
@@ -361,6 +370,40 @@ impl Fitter {
     }
 }
 
+/// Light-space distance range of the part of the caster box that lies over the
+/// footprint `[xy_lo, xy_hi]` (the prism swept along the light), `None` if none does.
+fn caster_depth_over(
+    light_from_world: &DMat4,
+    casters: &Aabb,
+    xy_lo: DVec2,
+    xy_hi: DVec2,
+) -> Result<Option<(f64, f64)>, FrustumError> {
+    use crate::geometry::DPlane;
+    let row = |r: usize| {
+        let m = light_from_world;
+        DVec3::new(m.x_axis[r], m.y_axis[r], m.z_axis[r])
+    };
+    let (rx, ry, rz) = (row(0), row(1), row(2));
+    let boxed = casters.transformed(&light_from_world.as_mat4());
+    let pad = 1.0 + f64::from(boxed.size().max_element());
+    // The light frame is a rotation, so light-space coordinates are dot products.
+    let prism = [
+        DPlane::new(rx, -xy_lo.x),
+        DPlane::new(-rx, xy_hi.x),
+        DPlane::new(ry, -xy_lo.y),
+        DPlane::new(-ry, xy_hi.y),
+        DPlane::new(rz, -(f64::from(boxed.min.z) - pad)),
+        DPlane::new(-rz, f64::from(boxed.max.z) + pad),
+    ];
+    let body = ConvexBody::from_planes_aabb(&prism, &casters.corners(), casters)?;
+    let mut range: Option<(f64, f64)> = None;
+    for v in body.vertices() {
+        let d = -rz.dot(v.as_dvec3());
+        range = Some(range.map_or((d, d), |(a, b)| (a.min(d), b.max(d))));
+    }
+    Ok(range)
+}
+
 /// A bounding sphere of a slice from its view-space corners. It depends only on the
 /// projection and the depths, never on the camera's pose, so its radius is exactly
 /// invariant under camera rotation. The centre lies on the segment between the near
@@ -371,7 +414,10 @@ pub(crate) fn bounding_sphere(corners: &[DVec3; 8]) -> (DVec3, f64) {
     let far_c = (corners[4] + corners[5] + corners[6] + corners[7]) * 0.25;
     let radius_at = |t: f64| {
         let c = near_c.lerp(far_c, t);
-        corners.iter().map(|p| p.distance_squared(c)).fold(0.0, f64::max)
+        corners
+            .iter()
+            .map(|p| p.distance_squared(c))
+            .fold(0.0, f64::max)
     };
     // The farthest-corner distance is convex along the segment: ternary search.
     let (mut a, mut b) = (0.0f64, 1.0f64);

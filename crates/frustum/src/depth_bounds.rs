@@ -15,10 +15,10 @@ pub struct DepthBounds {
 impl DepthBounds {
     /// The bounds clamped into the camera's depth range.
     ///
-    /// Documented fallbacks: bounds that are inverted, non-finite, outside the range
-    /// or thinner than `f32` can resolve (an empty reduction, a frame that sees only
-    /// sky) give the camera's whole range, so a renderer never has to special-case
-    /// them.
+    /// Documented fallbacks: a NaN bound is replaced by the camera's own; bounds that
+    /// are inverted or thinner than `f32` can resolve (an empty reduction, a frame that
+    /// sees only sky) give the camera's whole range, so a renderer never has to
+    /// special-case them.
     ///
     /// # Errors
     /// Only errors of [`Camera::validate`].

@@ -43,6 +43,9 @@ pub enum FrustumError {
     /// The light lies inside (or on) the region it must cover, so no projection
     /// from its position can see all of it.
     LightInsideRegion,
+    /// The frustum (or slice) has no volume at `f32` precision: it is too small for its
+    /// distance from the world origin, or its corners are coplanar.
+    DegenerateFrustum,
     /// A light kind the builder does not handle (for example a point light given to
     /// the directional cascade fit).
     UnsupportedLight,
@@ -72,6 +75,7 @@ impl fmt::Display for FrustumError {
             Self::InvalidResolution => f.write_str("shadow-map resolution is zero or too large"),
             Self::InvalidLight => f.write_str("light parameters out of range"),
             Self::LightInsideRegion => f.write_str("light lies inside the region to cover"),
+            Self::DegenerateFrustum => f.write_str("frustum has no volume at f32 precision"),
             Self::UnsupportedLight => f.write_str("light kind not supported by this builder"),
         }
     }

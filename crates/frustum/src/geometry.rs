@@ -202,13 +202,13 @@ impl DPlane {
         }
     }
 
-    /// Plane through three points, inward side given by counter-clockwise order seen from inside.
-    pub(crate) fn through(a: DVec3, b: DVec3, c: DVec3) -> Option<Self> {
-        let n = (b - a).cross(c - a).try_normalize()?;
-        Some(Self {
-            normal: n,
-            d: -n.dot(a),
-        })
+    /// The half-space `normal . p + d >= 0` (normal need not be unit).
+    pub(crate) fn new(normal: DVec3, d: f64) -> Self {
+        let len = normal.length();
+        Self {
+            normal: normal / len,
+            d: d / len,
+        }
     }
 
     pub(crate) fn distance(&self, p: DVec3) -> f64 {

@@ -96,7 +96,9 @@ pub use depth_bounds::DepthBounds;
 pub use error::FrustumError;
 pub use geometry::{Aabb, Plane, Sphere};
 pub use light::{Light, directional_light_from_world};
-pub use mapping::{LightDirection, ShadowMapping, ShadowSample, ShadowTransform, UV_FROM_CLIP};
+pub use mapping::{
+    LightDirection, ShadowMapping, ShadowSample, ShadowTransform, UV_FROM_CLIP, is_invertible,
+};
 pub use split::{CascadeBlend, CascadeSplits, MAX_CASCADES, SplitScheme};
 pub use spot::{SpotShadow, fit_spot};
 

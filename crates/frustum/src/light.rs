@@ -36,7 +36,8 @@ impl Light {
     /// # Errors
     /// [`FrustumError::NonFinite`], [`FrustumError::ZeroDirection`],
     /// [`FrustumError::InvalidLight`] for a spot angle outside `(0, pi/2)` or a range
-    /// that is not positive.
+    /// outside `[1e-6, 1e15]` (the near plane, a fraction of the range, must stay a
+    /// normal `f32`).
     pub fn validate(&self) -> Result<(), FrustumError> {
         match *self {
             Self::Directional { direction } => unit(direction).map(|_| ()),
@@ -51,7 +52,10 @@ impl Light {
                 }
                 unit(direction)?;
                 let max = core::f32::consts::FRAC_PI_2 - 1e-4;
-                if !(half_angle > 1e-5 && half_angle < max && range > 0.0) {
+                if !(half_angle > 1e-5
+                    && half_angle < max
+                    && (MIN_RANGE..=MAX_RANGE).contains(&range))
+                {
                     return Err(FrustumError::InvalidLight);
                 }
                 Ok(())
@@ -60,7 +64,7 @@ impl Light {
                 if !(position.is_finite() && range.is_finite()) {
                     return Err(FrustumError::NonFinite);
                 }
-                if range > 0.0 {
+                if (MIN_RANGE..=MAX_RANGE).contains(&range) {
                     Ok(())
                 } else {
                     Err(FrustumError::InvalidLight)
@@ -69,6 +73,11 @@ impl Light {
         }
     }
 }
+
+/// Smallest accepted light range.
+const MIN_RANGE: f32 = 1e-6;
+/// Largest accepted light range.
+const MAX_RANGE: f32 = 1e15;
 
 /// The unit vector along `v` in `f64`.
 pub(crate) fn unit(v: Vec3) -> Result<DVec3, FrustumError> {
@@ -90,7 +99,10 @@ pub(crate) fn unit(v: Vec3) -> Result<DVec3, FrustumError> {
 ///
 /// # Errors
 /// [`FrustumError::NonFinite`], [`FrustumError::ZeroDirection`].
-pub fn directional_light_from_world(direction: Vec3, up_hint: Vec3) -> Result<glam::Mat4, FrustumError> {
+pub fn directional_light_from_world(
+    direction: Vec3,
+    up_hint: Vec3,
+) -> Result<glam::Mat4, FrustumError> {
     light_from_world_rotation(unit(direction)?, up_hint).map(|m| m.as_mat4())
 }
 

@@ -129,6 +129,43 @@ impl ShadowMapping for ShadowTransform {
     }
 }
 
+/// Whether an `f32` matrix is finite and invertible with rows that `f32` can tell
+/// apart, for world coordinates of magnitude up to `world_scale`: a nonzero
+/// determinant, and no two rows of `m * diag(s, s, s, 1)` (s = `world_scale`) within
+/// `1e-6` rad of parallel. That is the failure `f32` rounding produces, e.g. a depth
+/// row equal to the `w` row for a tiny near plane far from the origin; scaling by the
+/// world's magnitude keeps the test independent of the world's units.
+pub fn is_invertible(m: &Mat4, world_scale: f32) -> bool {
+    if !m.is_finite() {
+        return false;
+    }
+    let d = m.as_dmat4();
+    let s = f64::from(world_scale.abs()).max(f64::MIN_POSITIVE);
+    let rows: [glam::DVec4; 4] = core::array::from_fn(|r| {
+        glam::DVec4::new(
+            d.x_axis[r] * s,
+            d.y_axis[r] * s,
+            d.z_axis[r] * s,
+            d.w_axis[r],
+        )
+    });
+    for i in 0..4 {
+        for j in i + 1..4 {
+            let (a, b) = (rows[i].length_squared(), rows[j].length_squared());
+            if a == 0.0 || b == 0.0 {
+                return false;
+            }
+            let dot = rows[i].dot(rows[j]);
+            // sin² of the angle between the rows.
+            if 1.0 - dot * dot / (a * b) < 1e-12 {
+                return false;
+            }
+        }
+    }
+    let det = d.determinant();
+    det != 0.0 && det.is_finite()
+}
+
 pub(crate) fn project_dmat(uv_from_world: &DMat4, p: DVec3) -> Option<ShadowSample> {
     let h = *uv_from_world * p.extend(1.0);
     if !(h.w > 0.0 && h.is_finite()) {

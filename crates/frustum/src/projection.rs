@@ -19,7 +19,15 @@ use crate::math;
 /// Orthographic projection of the box `[l, r] x [b, t]` between distances `near` and
 /// `far` (`near != far`; either may be negative).
 #[must_use]
-pub fn orthographic(l: f64, r: f64, b: f64, t: f64, near: f64, far: f64, reversed_z: bool) -> DMat4 {
+pub fn orthographic(
+    l: f64,
+    r: f64,
+    b: f64,
+    t: f64,
+    near: f64,
+    far: f64,
+    reversed_z: bool,
+) -> DMat4 {
     let (n, f) = if reversed_z { (far, near) } else { (near, far) };
     let rcp = 1.0 / (n - f);
     DMat4::from_cols(
@@ -66,7 +74,11 @@ pub fn perspective_infinite(fov_y: f64, aspect: f64, near: f64, reversed_z: bool
     let ty = math::tan(0.5 * fov_y);
     let tx = ty * aspect;
     // Limits of the depth row of `perspective` as far -> infinity.
-    let (a, b) = if reversed_z { (0.0, near) } else { (-1.0, -near) };
+    let (a, b) = if reversed_z {
+        (0.0, near)
+    } else {
+        (-1.0, -near)
+    };
     DMat4::from_cols(
         DVec4::new(1.0 / tx, 0.0, 0.0, 0.0),
         DVec4::new(0.0, 1.0 / ty, 0.0, 0.0),

@@ -61,7 +61,12 @@ pub fn fit_spot(
         }
         None => &frustum.corners,
     };
-    let mut tangents = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+    let mut tangents = [
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
     let mut straddles = false;
     let (mut d_min, mut d_max) = (f64::INFINITY, 0.0f64);
     for p in points {
@@ -107,10 +112,15 @@ pub fn fit_spot(
     if !(far > near * (1.0 + 1e-5)) {
         return Err(FrustumError::SliceOutsideScene);
     }
-    let clip_from_light = crate::projection::perspective_off_center(l, r, b, t, near, far, reversed_z);
+    let clip_from_light =
+        crate::projection::perspective_off_center(l, r, b, t, near, far, reversed_z);
     let clip_from_world = (clip_from_light * light_from_world).as_mat4();
-    if !clip_from_world.is_finite() || clip_from_world.determinant() == 0.0 {
-        return Err(FrustumError::EmptyBounds);
+    let reach = points
+        .iter()
+        .map(|p| p.abs().max_element())
+        .fold(position.abs().max_element(), f32::max);
+    if !crate::is_invertible(&clip_from_world, reach) {
+        return Err(FrustumError::DegenerateFrustum);
     }
     Ok(SpotShadow {
         transform: ShadowTransform::new(

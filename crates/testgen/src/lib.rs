@@ -20,8 +20,11 @@ use shadowmap_frustum::{Aabb, Camera, Projection, SplitScheme, projection};
 pub use arbitrary;
 
 pub mod frustum;
+#[cfg(feature = "paraboloid")]
 pub mod paraboloid;
+#[cfg(feature = "rtw")]
 pub mod rtw;
+#[cfg(feature = "warp")]
 pub mod warp;
 
 /// Result of a generator.
@@ -91,7 +94,14 @@ pub fn any_vec3(u: &mut Unstructured<'_>) -> GenResult<Vec3> {
 
 /// A unit vector, biased toward the axes and toward tiny deviations from them.
 pub fn unit_vec3(u: &mut Unstructured<'_>) -> GenResult<Vec3> {
-    const AXES: [Vec3; 6] = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z];
+    const AXES: [Vec3; 6] = [
+        Vec3::X,
+        Vec3::NEG_X,
+        Vec3::Y,
+        Vec3::NEG_Y,
+        Vec3::Z,
+        Vec3::NEG_Z,
+    ];
     let v = match u.int_in_range(0u8..=3)? {
         0 => AXES[usize::from(u.int_in_range(0u8..=5)?)],
         1 => {
@@ -229,9 +239,34 @@ pub fn camera(u: &mut Unstructured<'_>) -> GenResult<Camera> {
             far,
         },
     };
-    let camera = Camera::look_to(eye, forward, up, projection)
-        .unwrap_or_else(|_| fallback_camera(reversed_z));
-    Ok(camera.with_reversed_z(reversed_z))
+    // Keep the eye within f32-representable distance of its frustum: no farther from
+    // the origin than 1e4 times the frustum's smallest edge.
+    let at_origin =
+        Camera::look_to(Vec3::ZERO, forward, up, projection).map(|c| c.with_reversed_z(reversed_z));
+    let Ok(camera) = at_origin.and_then(|c| c.frustum().map(|f| (c, f))) else {
+        return Ok(fallback_camera(reversed_z));
+    };
+    let (camera, frustum) = camera;
+    let edges = [(0, 1), (1, 2), (0, 4), (4, 5), (5, 6)];
+    let smallest = edges
+        .iter()
+        .map(|(a, b)| frustum.corners[*a].distance(frustum.corners[*b]))
+        .fold(f32::INFINITY, f32::min);
+    let reach = (1e4 * smallest).min(1e3);
+    let eye = if eye.length() > reach {
+        eye.normalize_or_zero() * reach
+    } else {
+        eye
+    };
+    let moved = Camera {
+        world_from_view: Mat4::from_translation(eye) * camera.world_from_view,
+        ..camera
+    };
+    Ok(if moved.validate().is_ok() {
+        moved
+    } else {
+        camera
+    })
 }
 
 fn loop_free_up(u: &mut Unstructured<'_>, forward: Vec3) -> GenResult<Vec3> {

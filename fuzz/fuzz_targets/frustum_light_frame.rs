@@ -1,0 +1,12 @@
+#![no_main]
+//! Fuzzes `shadowmap-frustum`: light frame. Generator and check live in
+//! `shadowmap_testgen::frustum`, shared with the property tests.
+
+use libfuzzer_sys::fuzz_target;
+use shadowmap_testgen::{arbitrary::Unstructured, frustum};
+
+fuzz_target!(|data: &[u8]| {
+    if let Ok(case) = frustum::light_frame_case_raw(&mut Unstructured::new(data)) {
+        frustum::check_light_frame(&case);
+    }
+});
