@@ -1,0 +1,74 @@
+//! Per-frame cost of the IPSM plan with the exact minimal cone versus the paper's
+//! averaged cone (same configurations, same run), and of the two cone fits alone.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::Vec3;
+use shadowmap::frustum::{Camera, DepthBounds, Light, Projection};
+use shadowmap::paraboloid::{ConeFit, IpsmOptions, IpsmPlan, fit_minimal_cone, fit_paper_cone};
+use std::hint::black_box;
+use std::time::Duration;
+
+/// 64 fixed configurations: lights around a camera, inside and outside the frustum.
+fn configs() -> Vec<(Light, Camera, DepthBounds)> {
+    let camera = Camera::look_to(
+        Vec3::new(10.0, 1.8, 3.0),
+        Vec3::new(0.3, -0.15, -1.0),
+        Vec3::Y,
+        Projection::perspective(1.0, 16.0 / 9.0, 0.1, 500.0),
+    )
+    .unwrap();
+    (0..64)
+        .map(|i| {
+            let t = i as f32 * 0.7;
+            let position = Vec3::new(80.0 * t.cos(), 20.0 + 5.0 * (i % 7) as f32, 80.0 * t.sin());
+            let bounds = DepthBounds {
+                min: 0.5 + (i % 5) as f32,
+                max: 40.0 + 20.0 * (i % 9) as f32,
+            };
+            (
+                Light::Point {
+                    position,
+                    range: 2000.0,
+                },
+                camera,
+                bounds,
+            )
+        })
+        .collect()
+}
+
+fn plan(c: &mut Criterion) {
+    let cases = configs();
+    let mut g = c.benchmark_group("ipsm_plan_64");
+    g.warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(2));
+    for (name, fit) in [("paper", ConeFit::Paper), ("exact", ConeFit::Exact)] {
+        let options = IpsmOptions::default().with_fit(fit);
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                for (light, camera, bounds) in &cases {
+                    black_box(IpsmPlan::new(light, camera, Some(*bounds), &options).unwrap());
+                }
+            });
+        });
+    }
+    g.finish();
+
+    let plan = IpsmPlan::new(
+        &cases[0].0,
+        &cases[0].1,
+        Some(cases[0].2),
+        &IpsmOptions::default(),
+    )
+    .unwrap();
+    let dirs = plan.border_points.map(|p| p - plan.map.position);
+    let mut g = c.benchmark_group("cone_fit_8");
+    g.warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(2));
+    g.bench_function("paper", |b| b.iter(|| fit_paper_cone(black_box(&dirs))));
+    g.bench_function("exact", |b| b.iter(|| fit_minimal_cone(black_box(&dirs))));
+    g.finish();
+}
+
+criterion_group!(benches, plan);
+criterion_main!(benches);

@@ -1,0 +1,15 @@
+#![no_main]
+//! Fuzzes `shadowmap-paraboloid`: `ParaboloidMap::dual` / `single` and the lookups.
+//! Generator and check live in `shadowmap_testgen::paraboloid`, shared with the
+//! property tests.
+
+use libfuzzer_sys::fuzz_target;
+use shadowmap_testgen::{arbitrary::Unstructured, paraboloid};
+
+fuzz_target!(|data: &[u8]| {
+    if let Ok(input) = paraboloid::map_input_raw(&mut Unstructured::new(data)) {
+        if let Err(e) = paraboloid::check_map(&input) {
+            panic!("{e}: {input:?}");
+        }
+    }
+});
