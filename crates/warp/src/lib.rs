@@ -1,2 +1,163 @@
-//! Not yet implemented: see the open issue for this crate.
+//! Focus regions and perspective shadow-map warps for directional lights: uniform
+//! focused, LiSPSM, XPSM, TSM and warped cascades.
+//!
+//! Every technique returns the same output, a [`ShadowTransform`] of
+//! `shadowmap-frustum` (wrapped with technique-specific extras): the depth-pass
+//! matrix `clip_from_world` (WebGPU clip space), the lookup matrix `uv_from_world`
+//! (texture `v` down, divide by `w`), the conversion of a world-space depth bias into
+//! the technique's depth ([`ShadowTransform::depth_bias`], exact through the warp)
+//! and the world size of a texel at a point ([`ShadowTransform::texel_world_size`],
+//! from the Jacobian of the mapping) for normal-offset bias.
+//!
+//! - [`uniform_focused`]: orthographic fit of frustum ∩ receivers in light space, near
+//!   plane pulled back to the casters. The baseline.
+//! - [`lispsm`]: light space perspective shadow maps (Wimmer, Scherzer and
+//!   Purgathofer, *Light Space Perspective Shadow Maps*, EGSR 2004) with the strength
+//!   parameter `eta` of Lloyd, Tuft, Yoon and Manocha (*Warping and Partitioning for
+//!   Low Error Shadow Maps*, EGSR 2006) and a fade to uniform as the light turns
+//!   parallel to the view.
+//! - [`xpsm`]: extended perspective shadow maps (Gusev, *Extended Perspective Shadow
+//!   Maps*, 2007), all 18 steps, with the warped-space Z bias.
+//! - [`tsm`]: trapezoidal shadow maps (Martin and Tan, *Anti-aliasing and Continuity
+//!   with Trapezoidal Shadow Maps*, EGSR 2004) with the 80% focus rule.
+//! - [`warped_cascades`]: LiSPSM (or uniform) per parallel split (PSSM + LiSPSM) with a
+//!   strength per cascade.
+//!
+//! # Example
+//!
+//! ```
+//! use glam::Vec3;
+//! use shadowmap_frustum::{Aabb, Camera, Projection};
+//! use shadowmap_warp::{FocusScene, LispsmOptions, UniformOptions, lispsm, uniform_focused};
+//!
+//! let camera = Camera::look_to(
+//!     Vec3::new(0.0, 2.0, 0.0),
+//!     Vec3::NEG_Z,
+//!     Vec3::Y,
+//!     Projection::perspective(60f32.to_radians(), 16.0 / 9.0, 0.5, 100.0),
+//! )?;
+//! let scene = FocusScene::whole(Aabb::new(Vec3::new(-100.0, 0.0, -120.0), Vec3::new(100.0, 20.0, 10.0)));
+//! let light = Vec3::new(0.3, -1.0, -0.2);
+//!
+//! let uniform = uniform_focused(&camera, light, &scene, &UniformOptions::default())?;
+//! let warped = lispsm(&camera, light, &scene, &LispsmOptions::default().with_eta(0.0))?;
+//!
+//! // A visible ground point lands inside both maps...
+//! let p = Vec3::new(1.0, 0.0, -10.0);
+//! for t in [uniform, warped.transform] {
+//!     let s = t.project(p).unwrap();
+//!     assert!((0.0..=1.0).contains(&s.uv.x) && (0.0..=1.0).contains(&s.uv.y));
+//!     assert!((0.0..=1.0).contains(&s.depth));
+//! }
+//! // ...and LiSPSM spends more texels on it than the uniform fit.
+//! let size_u = uniform.texel_world_size(p, 2048).unwrap();
+//! let size_l = warped.transform.texel_world_size(p, 2048).unwrap();
+//! assert!(size_l < size_u);
+//! # Ok::<(), shadowmap_warp::WarpError>(())
+//! ```
+//!
+//! # Conventions
+//!
+//! | what | convention |
+//! |---|---|
+//! | handedness | right-handed world, y up; cameras look down `-Z` |
+//! | light frame | rotation only; the light looks down `-Z`; `+Y` is the warp axis ([`light_frame`]) |
+//! | clip space | WebGPU: x, y in `[-1, 1]`, depth in `[0, 1]` (reversed-Z an option) |
+//! | texture space | `uv_from_world = UV_FROM_CLIP * clip_from_world`, `v` down, divide by `w` |
+//! | light direction | the direction the light travels (from the light into the scene) |
+//! | precision | public API in `f32`; every fit is computed in `f64` and converted |
+//!
+//! The warp of LiSPSM in the light frame, with `s = 1/n` (`n` the distance from the
+//! projection centre to the near face of the body along the warp axis):
+//!
+//! ```text
+//! (x, y, z)  ->  (x - x_c, y - y_0, z - z_c) / (1 + s (y - y_0))
+//! s = 0                                  uniform (eta = -1)
+//! n_opt = (z_n + sqrt(z_n z_f)) / sin γ   LiSPSM (eta = 0), γ = angle(view, light)
+//! n_psm = z_n / sin γ                     PSM-like (eta = 1)
+//! ln(1 + s d) interpolated linearly in eta on [-1, 0] and on [0, 1]
+//! ```
+//!
+//! then an orthographic fit of the warped body. Texel density along the warp axis
+//! falls from the near to the far face of the body by `(1 + s d)²`, across it by
+//! `(1 + s d)`; for the overhead light (`γ = 90°`) at `eta = 0`, `1 + s d = sqrt(f/n)`.
+//!
+//! # Bad input and fallbacks
+//!
+//! Every builder returns a [`WarpError`]: an invalid camera ([`WarpError::Frustum`]),
+//! a non-finite or zero light direction, inverted receiver or caster boxes, receivers
+//! that miss the view frustum, options out of range, or (for absurd magnitudes) a
+//! result that would not be a finite invertible `f32` matrix. Documented fallbacks,
+//! none of which is an error:
+//!
+//! - light parallel to the view direction: the warp fades smoothly to the uniform
+//!   fit (LiSPSM between [`LispsmOptions::fade_start_deg`] and
+//!   [`LispsmOptions::fade_end_deg`], TSM likewise; XPSM's miner's-lamp case below
+//!   [`XpsmOptions::miner_lamp_threshold`]), and the light frame turns continuously
+//!   toward the camera's up vector, so nothing pops;
+//! - zero-area focus region (a point, or a flat box seen edge-on): widened to
+//!   [`MIN_RELATIVE_EXTENT`] times the scene's largest coordinate;
+//! - camera inside the caster volume (casters behind the viewer): uniform, LiSPSM and
+//!   TSM only keep the casters that can shadow visible receivers (caster box ∩ the
+//!   receivers' prism along the light); XPSM clips its projection vector against the
+//!   back-projection singularity;
+//! - warps too strong for `f32` matrices: clamped by [`MAX_WARP_RATIO`] (also
+//!   relative to the scene's distance from the world origin);
+//! - a cascade slice that misses the receivers: `shadow: None` in
+//!   [`warped_cascades`].
+//!
+//! The light's depth range runs from the highest caster that can shadow a visible
+//! receiver to the farthest visible receiver. Receivers outside the visible region
+//! (and, for XPSM, outside the casters' footprint) may fall outside the map: sample
+//! outside `[0, 1]²` as lit.
+//!
+//! No light frame can vary continuously with the light over the whole sphere (the
+//! hairy-ball theorem). [`light_frame`] puts its two singular directions inside the
+//! blend band, at a light between 2 and 10 degrees from the view direction (or its
+//! opposite) in the plane of the view and up vectors; near them, and only there,
+//! the map turns fast about the light axis (up to about 20 times the light's turn
+//! elsewhere in the band).
+//!
+//! # Features
+//!
+//! `std` (default) or `libm` provides float math; without `std` the crate is
+//! `no_std`. No builder allocates on the heap.
+
 #![cfg_attr(not(feature = "std"), no_std)]
+
+mod cascades;
+mod error;
+mod focus;
+mod lispsm;
+mod tsm;
+mod xpsm;
+
+pub use cascades::{WarpedCascade, WarpedCascades, warped_cascades};
+pub use error::WarpError;
+pub use focus::{FocusScene, MIN_RELATIVE_EXTENT};
+pub use lispsm::{
+    LispsmOptions, LispsmShadow, MAX_WARP_RATIO, UniformOptions, lispsm, uniform_focused,
+};
+pub use shadowmap_frustum::{ShadowTransform, glam};
+pub use tsm::{TsmOptions, TsmShadow, tsm};
+pub use xpsm::{XpsmOptions, XpsmShadow, xpsm};
+
+use glam::{Mat4, Vec3};
+use shadowmap_frustum::Camera;
+
+/// The light frame every technique of this crate uses (rotation only): the light
+/// looks down `-Z` and `+Y` is the warp axis.
+///
+/// The warp axis is the camera's viewing direction made perpendicular to the light.
+/// When the light is within 10 degrees of the viewing direction, the camera's up
+/// vector (made perpendicular) is blended in, fully below 2 degrees, so the frame
+/// stays defined and continuous as the light passes the viewing direction.
+///
+/// # Errors
+/// [`WarpError::Frustum`], [`WarpError::NonFinite`], [`WarpError::ZeroDirection`].
+pub fn light_frame(camera: &Camera, light_direction: Vec3) -> Result<Mat4, WarpError> {
+    camera.validate()?;
+    let view = focus::View::with_frustum(camera, camera.frustum()?)?;
+    let light = focus::light_unit(light_direction)?;
+    Ok(focus::frame(light, view.forward, view.up).0.as_mat4())
+}

@@ -1,0 +1,364 @@
+//! The shared first stage of every technique: input checks, the light frame, and the
+//! focus body (frustum ∩ receivers, extruded toward the light for the casters).
+
+use arrayvec::ArrayVec;
+use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
+use shadowmap_frustum::{
+    Aabb, Camera, ConvexBody, Frustum, LightDirection, MAX_BODY_VERTICES, ShadowTransform, math,
+};
+
+use crate::WarpError;
+
+/// What casts and what receives shadows, as world-space boxes.
+///
+/// `receivers` bounds every surface that must look up the map; `casters` bounds every
+/// surface that is drawn into it. Often both are the scene bounds
+/// ([`FocusScene::whole`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FocusScene {
+    /// Bounds of the shadow receivers.
+    pub receivers: Aabb,
+    /// Bounds of the shadow casters.
+    pub casters: Aabb,
+}
+
+impl FocusScene {
+    /// Receivers and casters given separately.
+    #[must_use]
+    pub const fn new(receivers: Aabb, casters: Aabb) -> Self {
+        Self { receivers, casters }
+    }
+
+    /// One box that both casts and receives.
+    #[must_use]
+    pub const fn whole(scene: Aabb) -> Self {
+        Self {
+            receivers: scene,
+            casters: scene,
+        }
+    }
+}
+
+/// `sin` of the angle between view and light below which the light frame starts to
+/// lean on the camera's up vector (see [`light_frame`](crate::light_frame)).
+pub(crate) const FRAME_BLEND_HI: f64 = 0.173_648_177_666_930_35; // sin 10°
+/// `sin` of the angle below which the light frame follows the camera's up vector only.
+pub(crate) const FRAME_BLEND_LO: f64 = 0.034_899_496_702_500_97; // sin 2°
+
+/// Cubic smoothstep of `x` between `lo < hi`.
+pub(crate) fn smoothstep(lo: f64, hi: f64, x: f64) -> f64 {
+    if !(hi > lo) {
+        return if x >= hi { 1.0 } else { 0.0 };
+    }
+    let t = ((x - lo) / (hi - lo)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// The view a technique serves: a frustum (the whole camera or one slice), the eye,
+/// and the camera's axes.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct View {
+    pub(crate) frustum: Frustum,
+    pub(crate) eye: DVec3,
+    pub(crate) forward: DVec3,
+    pub(crate) up: DVec3,
+}
+
+impl View {
+    pub(crate) fn camera(camera: &Camera) -> Result<Self, WarpError> {
+        let frustum = camera.frustum()?;
+        Self::with_frustum(camera, frustum)
+    }
+
+    pub(crate) fn with_frustum(camera: &Camera, frustum: Frustum) -> Result<Self, WarpError> {
+        let eye = camera.eye().as_dvec3();
+        let forward = camera.forward().as_dvec3().try_normalize();
+        let up = camera
+            .world_from_view
+            .y_axis
+            .truncate()
+            .as_dvec3()
+            .try_normalize();
+        match (forward, up) {
+            (Some(forward), Some(up)) if eye.is_finite() => Ok(Self {
+                frustum,
+                eye,
+                forward,
+                up,
+            }),
+            _ => Err(WarpError::Degenerate),
+        }
+    }
+}
+
+/// Unit light travel direction in `f64`.
+pub(crate) fn light_unit(direction: Vec3) -> Result<DVec3, WarpError> {
+    if !direction.is_finite() {
+        return Err(WarpError::NonFinite);
+    }
+    direction
+        .as_dvec3()
+        .try_normalize()
+        .filter(|d| d.length_squared() > 0.5)
+        .ok_or(WarpError::ZeroDirection)
+}
+
+/// The light frame shared by every technique: rotation only, light looking down `-Z`,
+/// `+Y` the warp axis (the view direction made perpendicular to the light, blended
+/// toward the camera's up vector as the light turns parallel to the view).
+///
+/// Returns the rotation and `sin γ`, `γ` the angle between view and light direction.
+pub(crate) fn frame(light: DVec3, forward: DVec3, cam_up: DVec3) -> (DMat4, f64) {
+    let v_perp = forward - light * forward.dot(light);
+    let sin_g = v_perp.length().min(1.0);
+    let u_perp = cam_up - light * cam_up.dot(light);
+    let c = 1.0 - smoothstep(FRAME_BLEND_LO, FRAME_BLEND_HI, sin_g);
+    let mut up = v_perp + u_perp * c;
+    up -= light * up.dot(light);
+    let up = up.try_normalize().unwrap_or_else(|| {
+        // Only on the (measure-zero) directions where the blend cancels: any axis
+        // perpendicular to the light keeps the frame valid.
+        light.any_orthonormal_vector()
+    });
+    let z = -light;
+    let x = up.cross(z).normalize();
+    let y = z.cross(x);
+    let rot = DMat4::from_cols(
+        DVec4::new(x.x, y.x, z.x, 0.0),
+        DVec4::new(x.y, y.y, z.y, 0.0),
+        DVec4::new(x.z, y.z, z.z, 0.0),
+        DVec4::W,
+    );
+    (rot, sin_g)
+}
+
+/// Checked scene boxes.
+pub(crate) fn check_scene(scene: &FocusScene) -> Result<(Aabb, Aabb), WarpError> {
+    let (r, c) = (scene.receivers, scene.casters);
+    if !(r.is_finite() && c.is_finite()) {
+        return Err(WarpError::NonFinite);
+    }
+    if !r.is_valid() {
+        return Err(WarpError::EmptyReceivers);
+    }
+    if !c.is_valid() {
+        return Err(WarpError::EmptyCasters);
+    }
+    Ok((r, c))
+}
+
+/// Points of a convex body (fixed capacity).
+pub(crate) type Points = ArrayVec<DVec3, MAX_BODY_VERTICES>;
+
+/// The focus body of a view and light.
+#[derive(Clone, Debug)]
+pub(crate) struct Focus {
+    pub(crate) light: DVec3,
+    /// Light frame (rotation only).
+    pub(crate) rot: DMat4,
+    pub(crate) sin_gamma: f64,
+    /// Vertices of frustum ∩ receivers (world).
+    pub(crate) receivers: Points,
+    /// The same extruded toward the light, clipped by the scene box (world); contains
+    /// `receivers`.
+    pub(crate) casters: Points,
+    /// The checked caster box.
+    pub(crate) caster_box: Aabb,
+}
+
+pub(crate) fn focus(view: &View, light: Vec3, scene: &FocusScene) -> Result<Focus, WarpError> {
+    let dir = light_unit(light)?;
+    let (receivers, casters) = check_scene(scene)?;
+    let body = ConvexBody::from_frustum_aabb(&view.frustum, &receivers)?;
+    if body.is_empty() {
+        return Err(WarpError::NoVisibleReceivers);
+    }
+    let (rot, sin_gamma) = frame(dir, view.forward, view.up);
+    let receivers: Points = body.vertices().iter().map(|v| v.as_dvec3()).collect();
+    let casters = caster_points(&rot, &receivers, &casters);
+    Ok(Focus {
+        light: dir,
+        rot,
+        sin_gamma,
+        receivers,
+        casters,
+        caster_box: scene.casters,
+    })
+}
+
+/// Smallest extent of a focus region, relative to the largest world coordinate of the
+/// focus body: thinner regions (a point or a flat sheet of receivers seen edge-on)
+/// are widened to it, so `f32` matrices stay well conditioned.
+pub const MIN_RELATIVE_EXTENT: f64 = 1e-5;
+
+/// The receivers' vertices plus the vertices of `caster box ∩ prism`, the prism being
+/// the receivers' light-space xy bounds extended along the light: every caster point
+/// that can shadow a visible receiver lies in that intersection, so the largest
+/// light-space `z` (toward the light) of these points bounds the casters that matter.
+///
+/// (`ConvexBody::extruded_toward_light` of `shadowmap-frustum` is not used: its hull
+/// misses casters when the ray toward the light leaves the scene box through a side
+/// face.)
+fn caster_points(rot: &DMat4, receivers: &Points, caster_box: &Aabb) -> Points {
+    let mut out = receivers.clone();
+    let mut b = Bounds::EMPTY;
+    for p in receivers {
+        b.add(rot.transform_point3(*p));
+    }
+    // Planes n.p + d >= 0 in world space.
+    let row = |r: usize| DVec3::new(rot.x_axis[r], rot.y_axis[r], rot.z_axis[r]);
+    let (lo, hi) = (caster_box.min.as_dvec3(), caster_box.max.as_dvec3());
+    let planes: [(DVec3, f64); 10] = [
+        (DVec3::X, -lo.x),
+        (DVec3::NEG_X, hi.x),
+        (DVec3::Y, -lo.y),
+        (DVec3::NEG_Y, hi.y),
+        (DVec3::Z, -lo.z),
+        (DVec3::NEG_Z, hi.z),
+        (row(0), -b.min.x),
+        (-row(0), b.max.x),
+        (row(1), -b.min.y),
+        (-row(1), b.max.y),
+    ];
+    let scale = lo
+        .abs()
+        .max(hi.abs())
+        .max_element()
+        .max(scale_of(receivers));
+    let tol = 1e-9 * scale;
+    let mut cands: ArrayVec<DVec3, 128> = ArrayVec::new();
+    for i in 0..10 {
+        for j in i + 1..10 {
+            for k in j + 1..10 {
+                let m = glam::DMat3::from_cols(planes[i].0, planes[j].0, planes[k].0).transpose();
+                let det = m.determinant();
+                if det.abs() < 1e-9 {
+                    continue;
+                }
+                let p = m.inverse() * DVec3::new(-planes[i].1, -planes[j].1, -planes[k].1);
+                if p.is_finite() && planes.iter().all(|(n, d)| n.dot(p) + d >= -tol) {
+                    let _ = cands.try_push(p);
+                }
+            }
+        }
+    }
+    // Keep the candidates that matter for the depth range: the highest toward the
+    // light (all of them when they fit).
+    let z_of = |p: &DVec3| rot.transform_point3(*p).z;
+    for p in &cands {
+        if out.try_push(*p).is_err() {
+            // Full: replace the lowest point if this one is higher.
+            if let Some((idx, _)) = out
+                .iter()
+                .enumerate()
+                .skip(receivers.len())
+                .min_by(|a, b| z_of(a.1).total_cmp(&z_of(b.1)))
+                && z_of(&out[idx]) < z_of(p)
+            {
+                out[idx] = *p;
+            }
+        }
+    }
+    out
+}
+
+/// Axis-aligned bounds of points in `f64`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Bounds {
+    pub(crate) min: DVec3,
+    pub(crate) max: DVec3,
+}
+
+impl Bounds {
+    pub(crate) const EMPTY: Self = Self {
+        min: DVec3::INFINITY,
+        max: DVec3::NEG_INFINITY,
+    };
+
+    pub(crate) fn add(&mut self, p: DVec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    pub(crate) fn is_empty(&self) -> bool {
+        !(self.min.cmple(self.max).all())
+    }
+
+    /// Widens thin axes to at least `MIN_RELATIVE_EXTENT * scale` (the documented
+    /// zero-area fallback), and every axis by a relative margin so that rounding keeps
+    /// points inside.
+    pub(crate) fn padded(mut self, scale: f64) -> Self {
+        let min_extent = MIN_RELATIVE_EXTENT * scale;
+        for axis in 0..3 {
+            let (lo, hi) = (self.min[axis], self.max[axis]);
+            let ext = hi - lo;
+            let pad = if ext < min_extent {
+                0.5 * (min_extent - ext)
+            } else {
+                0.0
+            } + 1e-6 * ext.max(min_extent);
+            self.min[axis] = lo - pad;
+            self.max[axis] = hi + pad;
+        }
+        self
+    }
+}
+
+/// Largest absolute coordinate of the points (at least a tiny positive number).
+pub(crate) fn scale_of(points: &[DVec3]) -> f64 {
+    points
+        .iter()
+        .map(|p| p.abs().max_element())
+        .fold(f64::MIN_POSITIVE, f64::max)
+}
+
+/// Orthographic fit of light-space bounds (`z` toward the light): x, y to the box,
+/// depth from the nearest (largest `z`) to the farthest.
+pub(crate) fn ortho_fit(b: &Bounds, reversed_z: bool) -> DMat4 {
+    shadowmap_frustum::projection::orthographic(
+        b.min.x, b.max.x, b.min.y, b.max.y, -b.max.z, -b.min.z, reversed_z,
+    )
+}
+
+/// Converts to the `f32` output, refusing non-finite or singular results.
+pub(crate) fn finish(
+    light_from_world: DMat4,
+    clip_from_world: DMat4,
+    reversed_z: bool,
+    light: DVec3,
+) -> Result<ShadowTransform, WarpError> {
+    let clip = clip_from_world.as_mat4();
+    let lfw = light_from_world.as_mat4();
+    if !(matrix_ok(&clip) && matrix_ok(&lfw)) {
+        return Err(WarpError::Degenerate);
+    }
+    let t = ShadowTransform::new(
+        lfw,
+        clip,
+        reversed_z,
+        LightDirection::Directional(light.as_vec3()),
+    );
+    if !matrix_ok(&t.uv_from_world) {
+        return Err(WarpError::Degenerate);
+    }
+    Ok(t)
+}
+
+/// Finite, with a finite non-zero determinant and a finite inverse.
+pub(crate) fn matrix_ok(m: &Mat4) -> bool {
+    if !m.is_finite() {
+        return false;
+    }
+    let det = m.as_dmat4().determinant();
+    det.is_finite() && det != 0.0 && (det as f32) != 0.0 && m.inverse().is_finite()
+}
+
+/// Light-space coordinates of world points.
+pub(crate) fn transform_points(m: &DMat4, pts: &[DVec3]) -> Points {
+    pts.iter().map(|p| m.transform_point3(*p)).collect()
+}
+
+/// `sqrt` that never returns NaN for tiny negative rounding.
+pub(crate) fn sqrt0(x: f64) -> f64 {
+    math::sqrt(x.max(0.0))
+}

@@ -1,0 +1,513 @@
+//! Uniform focused and light space perspective shadow maps (LiSPSM).
+
+use glam::{DMat4, DVec3, DVec4, Vec3};
+use shadowmap_frustum::{Camera, ShadowTransform, math};
+
+use crate::WarpError;
+use crate::focus::{
+    Bounds, Focus, FocusScene, View, finish, focus, ortho_fit, scale_of, smoothstep, sqrt0,
+    transform_points,
+};
+
+/// Largest warp ratio `1 + s d` (near-to-far texel scale along the warp axis) a
+/// LiSPSM, TSM or XPSM fit uses; stronger warps are clamped to it so `f32` matrices
+/// keep precision. The warp strength `s` is also limited to `MAX_WARP_RATIO / L`, `L`
+/// the largest light-space coordinate of the focus body (the world's distance from
+/// its origin matters: render camera-relative to lift the limit).
+pub const MAX_WARP_RATIO: f64 = 1.0e4;
+
+/// Options of [`uniform_focused`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct UniformOptions {
+    /// Depth 1 at the light's near plane and 0 at its far plane.
+    pub reversed_z: bool,
+}
+
+impl Default for UniformOptions {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl UniformOptions {
+    /// Standard depth.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self { reversed_z: false }
+    }
+
+    /// Sets [`reversed_z`](Self::reversed_z).
+    #[must_use]
+    pub const fn with_reversed_z(mut self, reversed_z: bool) -> Self {
+        self.reversed_z = reversed_z;
+        self
+    }
+}
+
+/// Options of [`lispsm`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct LispsmOptions {
+    /// Depth 1 at the light's near plane and 0 at its far plane.
+    pub reversed_z: bool,
+    /// Warp strength in `[-1, 1]`: `-1` uniform, `0` LiSPSM (`n_opt`), `1` PSM-like
+    /// (projection centre at the eye). Default 0.
+    pub eta: f32,
+    /// View depth below which shadows matter little (Filament's "near hint"): `n_opt`
+    /// uses `max(z_near, near_hint)`. Default 0 (none).
+    pub near_hint: f32,
+    /// View depth beyond which shadows matter little: `n_opt` uses
+    /// `min(z_far, far_hint)`. Default infinity (none).
+    pub far_hint: f32,
+    /// Angle (degrees) between view and light direction above which the warp has full
+    /// strength. Default 10.
+    pub fade_start_deg: f32,
+    /// Angle (degrees) below which the fit is exactly uniform. Default 3. Must be
+    /// below [`fade_start_deg`](Self::fade_start_deg).
+    pub fade_end_deg: f32,
+}
+
+impl Default for LispsmOptions {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl LispsmOptions {
+    /// Defaults: standard depth, `eta = 0`, no hints, fade between 10 and 3 degrees.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            reversed_z: false,
+            eta: 0.0,
+            near_hint: 0.0,
+            far_hint: f32::INFINITY,
+            fade_start_deg: 10.0,
+            fade_end_deg: 3.0,
+        }
+    }
+
+    /// Sets [`reversed_z`](Self::reversed_z).
+    #[must_use]
+    pub const fn with_reversed_z(mut self, reversed_z: bool) -> Self {
+        self.reversed_z = reversed_z;
+        self
+    }
+
+    /// Sets [`eta`](Self::eta).
+    #[must_use]
+    pub const fn with_eta(mut self, eta: f32) -> Self {
+        self.eta = eta;
+        self
+    }
+
+    /// Sets [`near_hint`](Self::near_hint) and [`far_hint`](Self::far_hint).
+    #[must_use]
+    pub const fn with_hints(mut self, near_hint: f32, far_hint: f32) -> Self {
+        self.near_hint = near_hint;
+        self.far_hint = far_hint;
+        self
+    }
+
+    /// Sets the parallel-light fade band, in degrees (`end < start`).
+    #[must_use]
+    pub const fn with_fade(mut self, start_deg: f32, end_deg: f32) -> Self {
+        self.fade_start_deg = start_deg;
+        self.fade_end_deg = end_deg;
+        self
+    }
+
+    pub(crate) fn check(&self) -> Result<(), WarpError> {
+        let ok = (-1.0..=1.0).contains(&self.eta)
+            && self.near_hint >= 0.0
+            && self.near_hint.is_finite()
+            && self.far_hint > 0.0
+            && !self.far_hint.is_nan()
+            && self.fade_end_deg >= 0.0
+            && self.fade_start_deg > self.fade_end_deg
+            && self.fade_start_deg <= 90.0;
+        if ok {
+            Ok(())
+        } else {
+            Err(WarpError::InvalidOption)
+        }
+    }
+}
+
+/// A LiSPSM fit: the matrices and the warp it chose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LispsmShadow {
+    /// The matrices (depth pass and lookup).
+    pub transform: ShadowTransform,
+    /// Distance `n` from the projection centre to the near face of the body along
+    /// the warp axis; infinite when the fit is uniform.
+    pub n: f32,
+    /// Parallel-light fade weight in `[0, 1]` (1: full warp, 0: uniform).
+    pub fade: f32,
+}
+
+/// Uniform focused shadow map of a directional light (the baseline every other
+/// technique is compared with).
+///
+/// An orthographic projection in the light frame (see [`light_frame`](crate::light_frame))
+/// fitted to frustum ∩ receivers, its near plane pulled back to the casters that can
+/// shadow them (the body extruded toward the light, clipped by
+/// `casters ∪ receivers`).
+///
+/// # Errors
+/// [`WarpError::Frustum`] for an invalid camera; [`WarpError::NonFinite`],
+/// [`WarpError::ZeroDirection`] for the light; [`WarpError::EmptyReceivers`],
+/// [`WarpError::EmptyCasters`] for inverted boxes; [`WarpError::NoVisibleReceivers`]
+/// when the receivers miss the frustum; [`WarpError::Degenerate`] when the `f32`
+/// result would be singular or non-finite. A focus region of zero area (a point or
+/// line of receivers) is widened (see the crate docs), not refused.
+pub fn uniform_focused(
+    camera: &Camera,
+    light_direction: Vec3,
+    scene: &FocusScene,
+    options: &UniformOptions,
+) -> Result<ShadowTransform, WarpError> {
+    let view = View::camera(camera)?;
+    let f = focus(&view, light_direction, scene)?;
+    warp_fit(&f, &view, 0.0, options.reversed_z).map(|(t, _)| t)
+}
+
+/// Light space perspective shadow map (Wimmer, Scherzer and Purgathofer 2004) with the
+/// strength parameter of Lloyd et al. (2006).
+///
+/// # Errors
+/// As [`uniform_focused`], and [`WarpError::InvalidOption`] for options out of range.
+pub fn lispsm(
+    camera: &Camera,
+    light_direction: Vec3,
+    scene: &FocusScene,
+    options: &LispsmOptions,
+) -> Result<LispsmShadow, WarpError> {
+    options.check()?;
+    let view = View::camera(camera)?;
+    lispsm_view(&view, light_direction, scene, options)
+}
+
+pub(crate) fn lispsm_view(
+    view: &View,
+    light_direction: Vec3,
+    scene: &FocusScene,
+    options: &LispsmOptions,
+) -> Result<LispsmShadow, WarpError> {
+    let f = focus(view, light_direction, scene)?;
+    let (s, fade) = warp_strength(&f, view, options);
+    let (transform, s) = warp_fit(&f, view, s, options.reversed_z)?;
+    Ok(LispsmShadow {
+        transform,
+        n: if s > 0.0 {
+            (1.0 / s) as f32
+        } else {
+            f32::INFINITY
+        },
+        fade: fade as f32,
+    })
+}
+
+/// The warp strength `s = 1/n` and the fade weight.
+fn warp_strength(f: &Focus, view: &View, o: &LispsmOptions) -> (f64, f64) {
+    let deg = core::f64::consts::PI / 180.0;
+    let fade = smoothstep(
+        math::sin(f64::from(o.fade_end_deg) * deg),
+        math::sin(f64::from(o.fade_start_deg) * deg),
+        f.sin_gamma,
+    );
+    if fade <= 0.0 || o.eta <= -1.0 {
+        return (0.0, fade);
+    }
+    // View-depth range of the visible receivers, narrowed by the hints.
+    let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in &f.receivers {
+        let d = (*p - view.eye).dot(view.forward);
+        z_n = z_n.min(d);
+        z_f = z_f.max(d);
+    }
+    let z_scale = z_f.abs().max(z_n.abs()).max(f64::MIN_POSITIVE);
+    z_n = z_n.max(f64::from(o.near_hint)).max(1e-6 * z_scale);
+    z_f = z_f.min(f64::from(o.far_hint)).max(z_n);
+    // Extent of the body along the warp axis.
+    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in &f.casters {
+        let y = f.rot.transform_point3(*p).y;
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    let d = (y1 - y0).max(0.0);
+    if !(d > 0.0) {
+        return (0.0, fade);
+    }
+    let sin_g = f.sin_gamma;
+    // Wimmer et al.: n_opt = (z_n + sqrt(z_n z_f)) / sin(gamma); PSM: n = z_n / sin(gamma).
+    let s_lisp = sin_g / (z_n + sqrt0(z_n * z_f));
+    let s_psm = sin_g / z_n;
+    let ln_r_lisp = ln_1p(s_lisp * d);
+    let ln_r_psm = ln_1p(s_psm * d);
+    let eta = f64::from(o.eta);
+    let ln_r = if eta <= 0.0 {
+        (1.0 + eta) * ln_r_lisp
+    } else {
+        ln_r_lisp + eta * (ln_r_psm - ln_r_lisp)
+    };
+    let ln_r = ln_r.min(math::ln(MAX_WARP_RATIO)) * fade;
+    let s = (math::exp(ln_r) - 1.0) / d;
+    if s.is_finite() && s > 0.0 {
+        (s, fade)
+    } else {
+        (0.0, fade)
+    }
+}
+
+fn ln_1p(x: f64) -> f64 {
+    if x < 1e-4 {
+        x - 0.5 * x * x + x * x * x / 3.0
+    } else {
+        math::ln(1.0 + x)
+    }
+}
+
+/// The warp: light-space `(x, y, z)` to `(x - x_c, y - y_0, z - z_c, 1 + s (y - y_0))`,
+/// then an orthographic fit of the warped body. `s = 0` is the uniform fit.
+///
+/// `s` is limited to `MAX_WARP_RATIO / L`, `L` the largest light-space coordinate of
+/// the body: the `f32` matrix computes `w = 1 + s y - s y_0` in world coordinates, so
+/// this keeps the rounding of `w` near `1e-3` relative. Returns the `s` used.
+pub(crate) fn warp_fit(
+    f: &Focus,
+    view: &View,
+    s: f64,
+    reversed_z: bool,
+) -> Result<(ShadowTransform, f64), WarpError> {
+    let ls_casters = transform_points(&f.rot, &f.casters);
+    let mut lb = Bounds::EMPTY;
+    for p in &ls_casters {
+        lb.add(*p);
+    }
+    let s = s.min(MAX_WARP_RATIO / scale_of(&ls_casters)).max(0.0);
+    let eye = f.rot.transform_point3(view.eye);
+    let x_c = eye.x.max(lb.min.x).min(lb.max.x);
+    let y0 = lb.min.y;
+    let z_c = 0.5 * (lb.min.z + lb.max.z);
+    let warp = DMat4::from_cols(
+        DVec4::new(1.0, 0.0, 0.0, 0.0),
+        DVec4::new(0.0, 1.0, 0.0, s),
+        DVec4::new(0.0, 0.0, 1.0, 0.0),
+        DVec4::new(-x_c, -y0, -z_c, 1.0 - s * y0),
+    );
+    let warp_from_world = warp * f.rot;
+    let project = |p: &DVec3| -> DVec3 { warp_from_world.project_point3(*p) };
+    // x, y and the far plane from the receivers; the near plane from the casters.
+    let mut b = Bounds::EMPTY;
+    for p in &f.receivers {
+        b.add(project(p));
+    }
+    for p in &f.casters {
+        let q = project(p);
+        b.max.z = b.max.z.max(q.z);
+    }
+    if b.is_empty() || !(b.min.is_finite() && b.max.is_finite()) {
+        return Err(WarpError::Degenerate);
+    }
+    let b = b.padded(scale_of(&f.casters));
+    let clip = ortho_fit(&b, reversed_z) * warp_from_world;
+    finish(f.rot, clip, reversed_z, f.light).map(|t| (t, s))
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec3, Vec3};
+    use shadowmap_frustum::{Aabb, Camera, Projection, ShadowMapping, ShadowTransform};
+
+    use super::*;
+
+    /// Texel density (texture units per world unit) along the view axis and across
+    /// it, at view depth `z`, by central differences.
+    fn density(t: &ShadowTransform, eye: DVec3, z: f64) -> (f64, f64) {
+        let p = eye + DVec3::new(0.0, 0.0, -z);
+        let h = 1e-4 * z;
+        let uv = |q: DVec3| t.map_point(q).unwrap().uv;
+        let along = (uv(p + DVec3::new(0.0, 0.0, -h)) - uv(p - DVec3::new(0.0, 0.0, -h))).length()
+            / (2.0 * h);
+        let across = (uv(p + DVec3::X * h) - uv(p - DVec3::X * h)).length() / (2.0 * h);
+        (along, across)
+    }
+
+    /// Storage factor of a fit for the overhead case (see `overhead_light_golden_ratios`).
+    fn storage_factor(
+        camera: &Camera,
+        light: Vec3,
+        scene: &FocusScene,
+        eta: f32,
+        n: f64,
+        f: f64,
+        tan: f64,
+    ) -> f64 {
+        let t = lispsm(
+            camera,
+            light,
+            scene,
+            &LispsmOptions::default().with_eta(eta),
+        )
+        .unwrap()
+        .transform;
+        let eye = camera.eye().as_dvec3();
+        let (mut mx, mut my) = (0.0f64, 0.0f64);
+        for i in 0..=400 {
+            let z = n * (f / n).powf(f64::from(i) / 400.0);
+            let (along, across) = density(&t, eye, z);
+            mx = mx.max(1.0 / (2.0 * tan * z * across));
+            my = my.max(1.0 / (2.0 * tan * z * along));
+        }
+        let v = |z: f64| t.map_point(eye + DVec3::new(0.0, 0.0, -z)).unwrap().uv.y;
+        mx * my * (v(f) - v(n)).abs()
+    }
+
+    /// Overhead light, horizontal camera, n = 1, f = 1000, fovY = 60°: the near/far
+    /// density ratios are the closed forms of the 1-D analysis (Wimmer et al. 2004,
+    /// Lloyd et al. 2006): `r = 1 + s d` is 1 (uniform), `sqrt(f/n)` (LiSPSM) and
+    /// `f/n` (PSM); along the view the ratio is `r²`, across it `r`. The storage
+    /// factors are GUIDE §5's: uniform `K (f - n) f / n²`, LiSPSM `K (f - n) / n`
+    /// (and PSM the same as LiSPSM in this separable 1-D measure).
+    #[test]
+    fn overhead_light_golden_ratios() {
+        let (n, f) = (1.0f32, 1000.0f32);
+        let eye = Vec3::new(0.0, 10.0, 0.0);
+        let camera = Camera::look_to(
+            eye,
+            Vec3::NEG_Z,
+            Vec3::Y,
+            Projection::perspective(60f32.to_radians(), 1.0, n, f),
+        )
+        .unwrap();
+        // Receivers and casters hold the whole frustum, so the body is the frustum.
+        let scene = FocusScene::whole(Aabb::new(
+            Vec3::new(-800.0, -800.0, -1100.0),
+            Vec3::new(800.0, 800.0, 10.0),
+        ));
+        let light = Vec3::NEG_Y;
+        let ratio = |r: f64| (r * r, r);
+        let fo = f64::from(f / n);
+        let cases = [
+            (-1.0, ratio(1.0)),
+            (0.0, ratio(fo.sqrt())),
+            (1.0, ratio(fo)),
+        ];
+        for (eta, (want_along, want_across)) in cases {
+            let t = lispsm(
+                &camera,
+                light,
+                &scene,
+                &LispsmOptions::default().with_eta(eta),
+            )
+            .unwrap()
+            .transform;
+            let (a0, c0) = density(&t, eye.as_dvec3(), f64::from(n));
+            let (a1, c1) = density(&t, eye.as_dvec3(), f64::from(f));
+            let (along, across) = (a0 / a1, c0 / c1);
+            eprintln!(
+                "golden: eta {eta}: density ratio n/f along {along:.4} (closed form {want_along:.4}), across {across:.4} ({want_across:.4})"
+            );
+            assert!(
+                (along / want_along - 1.0).abs() < 0.02,
+                "eta {eta}: along {along} vs {want_along}"
+            );
+            assert!(
+                (across / want_across - 1.0).abs() < 0.02,
+                "eta {eta}: across {across} vs {want_across}"
+            );
+        }
+        // The storage factors of GUIDE §5 from the measured densities (perspective-only,
+        // separable): S = max_z m_x(z) * max_z m_y(z) * (texels across the map) with
+        // m = (pixel density 1/(2 t z)) / (texel density), t = tan(fovY / 2).
+        let tan = (30f64).to_radians().tan();
+        let k = 1.0 / (2.0 * tan);
+        let (nf, ff) = (f64::from(n), f64::from(f));
+        for (eta, want) in [
+            (-1.0, k * (ff - nf) * ff / (nf * nf)),
+            (0.0, k * (ff - nf) / nf),
+            (1.0, k * (ff - nf) / nf),
+        ] {
+            let s = storage_factor(&camera, light, &scene, eta, nf, ff, tan);
+            eprintln!("golden: eta {eta}: storage factor S = {s:.4e} (closed form {want:.4e})");
+            assert!(
+                (s / want - 1.0).abs() < 0.02,
+                "eta {eta}: S = {s} vs {want}"
+            );
+        }
+        // n_opt = n + sqrt(n f).
+        let l = lispsm(&camera, light, &scene, &LispsmOptions::default()).unwrap();
+        let n_opt = 1.0 + 1000f32.sqrt();
+        assert!((l.n / n_opt - 1.0).abs() < 1e-3, "n = {} vs {n_opt}", l.n);
+        // The uniform fit is the eta = -1 fit.
+        let u = uniform_focused(&camera, light, &scene, &UniformOptions::default()).unwrap();
+        let (a0, _) = density(&u, eye.as_dvec3(), 1.0);
+        let (a1, _) = density(&u, eye.as_dvec3(), 1000.0);
+        assert!((a0 / a1 - 1.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn options_out_of_range_are_refused() {
+        let camera = Camera::look_to(
+            Vec3::ZERO,
+            Vec3::NEG_Z,
+            Vec3::Y,
+            Projection::perspective(1.0, 1.0, 0.1, 10.0),
+        )
+        .unwrap();
+        let scene = FocusScene::whole(Aabb::new(Vec3::splat(-20.0), Vec3::splat(20.0)));
+        for o in [
+            LispsmOptions::default().with_eta(1.5),
+            LispsmOptions::default().with_eta(f32::NAN),
+            LispsmOptions::default().with_fade(3.0, 10.0),
+            LispsmOptions::default().with_hints(-1.0, 10.0),
+        ] {
+            assert_eq!(
+                lispsm(&camera, Vec3::NEG_Y, &scene, &o).err(),
+                Some(WarpError::InvalidOption)
+            );
+        }
+        assert_eq!(
+            lispsm(&camera, Vec3::ZERO, &scene, &LispsmOptions::default()).err(),
+            Some(WarpError::ZeroDirection)
+        );
+        assert_eq!(
+            lispsm(
+                &camera,
+                Vec3::new(f32::NAN, 0.0, 0.0),
+                &scene,
+                &LispsmOptions::default()
+            )
+            .err(),
+            Some(WarpError::NonFinite)
+        );
+        let inverted = FocusScene::new(Aabb::new(Vec3::ONE, Vec3::ZERO), scene.casters);
+        assert_eq!(
+            uniform_focused(&camera, Vec3::NEG_Y, &inverted, &UniformOptions::default()).err(),
+            Some(WarpError::EmptyReceivers)
+        );
+        let inverted = FocusScene::new(scene.receivers, Aabb::new(Vec3::ONE, Vec3::ZERO));
+        assert_eq!(
+            uniform_focused(&camera, Vec3::NEG_Y, &inverted, &UniformOptions::default()).err(),
+            Some(WarpError::EmptyCasters)
+        );
+        let away = FocusScene::whole(Aabb::new(Vec3::splat(100.0), Vec3::splat(101.0)));
+        assert_eq!(
+            uniform_focused(&camera, Vec3::NEG_Y, &away, &UniformOptions::default()).err(),
+            Some(WarpError::NoVisibleReceivers)
+        );
+        // Near/far hints narrow n_opt's depth range: a far hint strengthens the warp.
+        let base = lispsm(&camera, Vec3::NEG_Y, &scene, &LispsmOptions::default()).unwrap();
+        let hinted = lispsm(
+            &camera,
+            Vec3::NEG_Y,
+            &scene,
+            &LispsmOptions::default().with_hints(0.0, 2.0),
+        )
+        .unwrap();
+        assert!(hinted.n < base.n);
+    }
+}

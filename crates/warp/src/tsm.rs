@@ -1,0 +1,229 @@
+//! Trapezoidal shadow maps (Martin and Tan 2004).
+
+use glam::Vec3;
+use shadowmap_frustum::{Camera, ShadowTransform, math};
+
+use crate::focus::{FocusScene, View, focus, smoothstep};
+use crate::lispsm::warp_fit;
+use crate::{MAX_WARP_RATIO, WarpError};
+
+/// Options of [`tsm`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct TsmOptions {
+    /// Depth 1 at the light's near plane and 0 at its far plane.
+    pub reversed_z: bool,
+    /// Where the focus point sits, as a fraction in `(0, 1)` of the visible
+    /// receivers' view-depth range: the region up to it gets 80% of the map (the
+    /// "80% rule"). Default 0.1.
+    pub focus: f32,
+    /// Angle (degrees) between view and light above which the trapezoid has full
+    /// strength. Default 10.
+    pub fade_start_deg: f32,
+    /// Angle (degrees) below which the fit is exactly uniform (the trapezoid is a
+    /// rectangle). Default 3.
+    pub fade_end_deg: f32,
+}
+
+impl Default for TsmOptions {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl TsmOptions {
+    /// Defaults: standard depth, focus 0.1, fade between 10 and 3 degrees.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            reversed_z: false,
+            focus: 0.1,
+            fade_start_deg: 10.0,
+            fade_end_deg: 3.0,
+        }
+    }
+
+    /// Sets [`reversed_z`](Self::reversed_z).
+    #[must_use]
+    pub const fn with_reversed_z(mut self, reversed_z: bool) -> Self {
+        self.reversed_z = reversed_z;
+        self
+    }
+
+    /// Sets [`focus`](Self::focus).
+    #[must_use]
+    pub const fn with_focus(mut self, focus: f32) -> Self {
+        self.focus = focus;
+        self
+    }
+
+    /// Sets the parallel-light fade band, in degrees (`end < start`).
+    #[must_use]
+    pub const fn with_fade(mut self, start_deg: f32, end_deg: f32) -> Self {
+        self.fade_start_deg = start_deg;
+        self.fade_end_deg = end_deg;
+        self
+    }
+
+    fn check(&self) -> Result<(), WarpError> {
+        let ok = self.focus > 0.0
+            && self.focus < 1.0
+            && self.fade_end_deg >= 0.0
+            && self.fade_start_deg > self.fade_end_deg
+            && self.fade_start_deg <= 90.0;
+        if ok {
+            Ok(())
+        } else {
+            Err(WarpError::InvalidOption)
+        }
+    }
+}
+
+/// A TSM fit: the matrices and the trapezoid's projection distance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TsmShadow {
+    /// The matrices (depth pass and lookup).
+    pub transform: ShadowTransform,
+    /// `η`: distance from the trapezoid's apex (the projection centre) to its top
+    /// edge along the centre line; infinite when the trapezoid is a rectangle.
+    pub eta: f32,
+}
+
+/// Trapezoidal shadow map (Martin and Tan 2004) of a directional light.
+///
+/// In the light's post-projective (here: orthographic, light frame) space the centre
+/// line runs along the view direction, which is the light frame's `+Y`
+/// ([`light_frame`](crate::light_frame)); the top and base edges of the trapezoid
+/// are perpendicular to it and touch the visible receivers (frustum ∩ receivers) on
+/// the near and far side, `λ` apart. The focus point at distance `δ'` from the top
+/// edge (see [`TsmOptions::focus`]) is mapped to the 80% line (`ξ = -0.6`):
+///
+/// ```text
+/// η = λ δ' (1 + ξ) / (λ (1 - ξ) - 2 δ')      (rectangle when δ' >= 0.8 λ)
+/// ```
+///
+/// and the sides are the tangents from the apex, `η` before the top edge, to the
+/// receivers. The trapezoid-to-square map is the projective warp of
+/// [`lispsm`](crate::lispsm) with `n = η`, followed by the same fit, so depth is
+/// handled as in LiSPSM (linear along every light ray, casters kept) rather than
+/// with TSM's separate depth pass.
+///
+/// # Errors
+/// As [`uniform_focused`](crate::uniform_focused), and [`WarpError::InvalidOption`].
+pub fn tsm(
+    camera: &Camera,
+    light_direction: Vec3,
+    scene: &FocusScene,
+    options: &TsmOptions,
+) -> Result<TsmShadow, WarpError> {
+    options.check()?;
+    let view = View::camera(camera)?;
+    let f = focus(&view, light_direction, scene)?;
+    let deg = core::f64::consts::PI / 180.0;
+    let fade = smoothstep(
+        math::sin(f64::from(options.fade_end_deg) * deg),
+        math::sin(f64::from(options.fade_start_deg) * deg),
+        f.sin_gamma,
+    );
+    // Top and base edges: the receivers' extent along the centre line.
+    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in &f.receivers {
+        let y = f.rot.transform_point3(*p).y;
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+        let d = (*p - view.eye).dot(view.forward);
+        z_n = z_n.min(d);
+        z_f = z_f.max(d);
+    }
+    let lambda = y1 - y0;
+    // The focus point on the centre line.
+    let z_focus = z_n + f64::from(options.focus) * (z_f - z_n);
+    let focus_point = view.eye + view.forward * z_focus;
+    let delta = (f.rot.transform_point3(focus_point).y - y0).clamp(0.0, lambda.max(0.0));
+    const XI: f64 = -0.6;
+    let denom = lambda * (1.0 - XI) - 2.0 * delta;
+    let mut s = if lambda > 0.0 && denom > 0.0 && delta > 0.0 {
+        denom / (lambda * delta * (1.0 + XI))
+    } else {
+        0.0
+    };
+    // Precision guard as in LiSPSM, then the parallel-light fade.
+    if lambda > 0.0 {
+        s = s.min((MAX_WARP_RATIO - 1.0) / lambda);
+    }
+    let s = if s.is_finite() { s * fade } else { 0.0 };
+    let (transform, s) = warp_fit(&f, &view, s, options.reversed_z)?;
+    Ok(TsmShadow {
+        transform,
+        eta: if s > 0.0 {
+            (1.0 / s) as f32
+        } else {
+            f32::INFINITY
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec3, Vec3};
+    use shadowmap_frustum::{Aabb, Camera, Projection, ShadowMapping};
+
+    use super::*;
+
+    #[test]
+    fn the_focus_point_lands_on_the_80_percent_line() {
+        let eye = Vec3::new(0.0, 10.0, 0.0);
+        let camera = Camera::look_to(
+            eye,
+            Vec3::NEG_Z,
+            Vec3::Y,
+            Projection::perspective(60f32.to_radians(), 1.0, 1.0, 1000.0),
+        )
+        .unwrap();
+        let scene = FocusScene::whole(Aabb::new(
+            Vec3::new(-800.0, -800.0, -1100.0),
+            Vec3::new(800.0, 800.0, 10.0),
+        ));
+        for focus in [0.05f32, 0.1, 0.3, 0.6] {
+            let t = tsm(
+                &camera,
+                Vec3::NEG_Y,
+                &scene,
+                &TsmOptions::default().with_focus(focus),
+            )
+            .unwrap();
+            assert!(t.eta.is_finite());
+            let depth = 1.0 + f64::from(focus) * 999.0;
+            let v = |z: f64| {
+                t.transform
+                    .map_point(eye.as_dvec3() + DVec3::new(0.0, 0.0, -z))
+                    .unwrap()
+                    .uv
+                    .y
+            };
+            // Fraction of the map's height from the near edge to the focus point.
+            let frac = (v(1.0) - v(depth)) / (v(1.0) - v(1000.0));
+            assert!((frac - 0.8).abs() < 1e-3, "focus {focus}: {frac}");
+        }
+        // Beyond 80% the trapezoid is a rectangle: the uniform fit.
+        let t = tsm(
+            &camera,
+            Vec3::NEG_Y,
+            &scene,
+            &TsmOptions::default().with_focus(0.9),
+        )
+        .unwrap();
+        assert!(t.eta.is_infinite());
+        assert_eq!(
+            tsm(
+                &camera,
+                Vec3::NEG_Y,
+                &scene,
+                &TsmOptions::default().with_focus(1.0)
+            )
+            .err(),
+            Some(WarpError::InvalidOption)
+        );
+    }
+}

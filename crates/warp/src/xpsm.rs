@@ -1,0 +1,510 @@
+//! Extended perspective shadow maps (Gusev 2007).
+
+use arrayvec::ArrayVec;
+use glam::{DMat4, DVec3, DVec4, Vec3};
+use shadowmap_frustum::{Camera, ShadowTransform};
+
+use crate::WarpError;
+use crate::focus::{Bounds, View, finish, focus, scale_of, smoothstep, sqrt0};
+
+/// Options of [`xpsm`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct XpsmOptions {
+    /// Depth 1 at the light's near plane and 0 at its far plane.
+    pub reversed_z: bool,
+    /// `epsilonW` of the paper, in `(0, 1)`: the smallest homogeneous `w` a point of
+    /// the focus region may get, i.e. how far toward infinity the warp may push in the
+    /// critical case (casters behind the viewer). Default 0.1.
+    pub epsilon_w: f32,
+    /// `coef` of the paper (inverse world units): warping `1 / (coef d + 1)` at view
+    /// distance `d`. `None` (default) picks `1 / sqrt(z_n z_f)` from the visible
+    /// receivers, which equals LiSPSM's `n_opt` warp for an overhead light.
+    pub coef: Option<f32>,
+    /// `|V_xy|` (the sine of the angle between view and light) below which the
+    /// miner's-lamp case applies: orthographic shadows with focusing. The paper
+    /// switches at 0.1; here the projection vector fades out between twice this
+    /// value and this value, so nothing pops. Default 0.1.
+    pub miner_lamp_threshold: f32,
+}
+
+impl Default for XpsmOptions {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl XpsmOptions {
+    /// Defaults: standard depth, `epsilon_w = 0.1`, automatic `coef`, threshold 0.1.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            reversed_z: false,
+            epsilon_w: 0.1,
+            coef: None,
+            miner_lamp_threshold: 0.1,
+        }
+    }
+
+    /// Sets [`reversed_z`](Self::reversed_z).
+    #[must_use]
+    pub const fn with_reversed_z(mut self, reversed_z: bool) -> Self {
+        self.reversed_z = reversed_z;
+        self
+    }
+
+    /// Sets [`epsilon_w`](Self::epsilon_w).
+    #[must_use]
+    pub const fn with_epsilon_w(mut self, epsilon_w: f32) -> Self {
+        self.epsilon_w = epsilon_w;
+        self
+    }
+
+    /// Sets [`coef`](Self::coef).
+    #[must_use]
+    pub const fn with_coef(mut self, coef: f32) -> Self {
+        self.coef = Some(coef);
+        self
+    }
+
+    /// Sets [`miner_lamp_threshold`](Self::miner_lamp_threshold).
+    #[must_use]
+    pub const fn with_miner_lamp_threshold(mut self, threshold: f32) -> Self {
+        self.miner_lamp_threshold = threshold;
+        self
+    }
+
+    fn validate(&self) -> Result<(), WarpError> {
+        let coef_ok = match self.coef {
+            Some(c) => c.is_finite() && c >= 0.0,
+            None => true,
+        };
+        let ok = self.epsilon_w > 0.0
+            && self.epsilon_w < 1.0
+            && coef_ok
+            && self.miner_lamp_threshold >= 0.0
+            && self.miner_lamp_threshold < 0.5;
+        if ok {
+            Ok(())
+        } else {
+            Err(WarpError::InvalidOption)
+        }
+    }
+}
+
+/// An XPSM fit: the matrices, the Z bias scale of step 18, and the quantities the
+/// algorithm chose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct XpsmShadow {
+    /// The matrices (depth pass and lookup).
+    pub transform: ShadowTransform,
+    /// `1 / (MaxZ - MinZ)`: a bias of `b` world units toward the light, applied in
+    /// light space, changes clip `z` (before the division by `w`) by exactly
+    /// `-b * z_bias_scale` (standard depth) or `+b * z_bias_scale` (reversed-Z); see
+    /// [`XpsmShadow::biased_clip_z`].
+    pub z_bias_scale: f32,
+    /// Length of the projection vector after clipping (0: orthographic).
+    pub length_p: f32,
+    /// The back-projection bound `maxLengthP` (infinite when there is none).
+    pub max_length_p: f32,
+    /// Miner's-lamp weight in `[0, 1]`: 1 is full warp, 0 the miner's-lamp case
+    /// (orthographic with focusing).
+    pub warp_weight: f32,
+}
+
+impl XpsmShadow {
+    /// Step 18, the correct Z bias: the clip `z` of a point biased by `bias` world
+    /// units toward the light, from its unbiased clip `z` (the shader then divides by
+    /// `w`): `Z' = Z - bias / (MaxZ - MinZ)` (standard depth; `+` for reversed-Z).
+    #[must_use]
+    pub fn biased_clip_z(&self, clip_z: f32, bias: f32) -> f32 {
+        let dz = bias * self.z_bias_scale;
+        if self.transform.reversed_z {
+            clip_z + dz
+        } else {
+            clip_z - dz
+        }
+    }
+}
+
+/// Homogeneous post-projective light-space point.
+type Hom = DVec4;
+
+/// Points of a box or body, plus room for clipping intersections.
+type Cloud = ArrayVec<Hom, 1100>;
+
+/// Extended perspective shadow map (Gusev 2007).
+///
+/// The 18 steps of the paper, in this crate's conventions (column vectors, light
+/// looking down `-Z`, WebGPU depth). Receivers are the vertices of frustum ∩
+/// receivers; casters the corners of the caster box.
+///
+/// 1. Light space: the shared light frame ([`light_frame`](crate::light_frame)) with
+///    its origin at the viewer.
+/// 2. The view vector in light space, `V`.
+/// 3. `unit P = V_xy / |V_xy|`, which is the frame's `+Y` whenever `V_xy` is not tiny
+///    (in the near-parallel band the frame turns continuously toward the camera's
+///    up vector). Miner's lamp: the paper switches to orthographic focusing at
+///    `|V_xy| < 0.1`; here the projection vector fades out between `2 t` and `t`
+///    ([`XpsmOptions::miner_lamp_threshold`]), ending in the same orthographic fit
+///    with focusing, so nothing pops.
+/// 4. `minCastersProj`, `minReceiversProj`: smallest projections on `unit P`.
+/// 5. `maxLengthP = (epsilonW - 1) / max(minCastersProj, minReceiversProj)` when the
+///    focus interval starts behind the viewer (no bound otherwise).
+/// 6. `lengthP = coef / cos γ`, `cos γ = |V_xy|`.
+/// 7. Clip: `lengthP = min(lengthP, maxLengthP)` when `maxLengthP > 0`. Then two
+///    precision guards: `1 + lengthP * maxProj <= MAX_WARP_RATIO` and
+///    `lengthP <= MAX_WARP_RATIO / L` ([`MAX_WARP_RATIO`](crate::MAX_WARP_RATIO)).
+/// 8. `Projection`: `w = 1 + lengthP (P · xy)`.
+/// 9. `ZRotation`, mapping `unit P` to `+X` (a rotation; the paper's matrix is a
+///    reflection, right for D3D's left-handed frame).
+/// 10. `PPLS = ZRotation * Projection` (they commute: the rotation leaves `w` alone).
+/// 11. Casters and receivers to PPLS, clipped at `w = epsilonW` (below).
+/// 12. Their PPLS boxes.
+/// 13. Focus region: intersection of the boxes in xy ([`WarpError::EmptyFocusRegion`]
+///     when empty; boxes that only touch, up to `f32` rounding, give a zero-area
+///     region that is widened).
+/// 14. `MinZ`, `MaxZ` over both boxes; the focus region basis.
+/// 15. Its inverse, the unit-cube transform.
+/// 16. Normalized space for WebGPU: `x, y` to `[-1, 1]`, depth `1 - z` (standard) or
+///     `z` (reversed-Z), both in `[0, 1]`.
+/// 17. `clip_from_world = Normalized * UnitCube * PPLS * LightSpace`.
+/// 18. Z bias: [`XpsmShadow::z_bias_scale`] `= 1 / (MaxZ - MinZ)` (the paper's D3D
+///     form, which is WebGPU's), applied by [`XpsmShadow::biased_clip_z`]:
+///
+/// ```text
+/// Z' = (Z - bias / (MaxZ - MinZ)) / W      standard depth
+/// Z' = (Z + bias / (MaxZ - MinZ)) / W      reversed-Z
+/// ```
+///
+/// Points with `w < epsilonW` (beyond the back-projection bound) are handled so that
+/// they never shrink the focus region wrongly: each point set is clipped by the plane
+/// `w = epsilonW` (its vertices in front plus the crossings of every segment between a
+/// vertex in front and one behind), and that clipped set gives the Z bounds and the xy
+/// boxes; the points behind the plane also enter the xy boxes with `w` raised to
+/// `epsilonW` (only widening them), but are excluded from the Z bounds. A caster that
+/// can shadow a visible receiver lies above it and so never has `w < epsilonW`.
+///
+/// Visible receivers outside the casters' light-space footprint are not covered by
+/// the focus region (nothing can shadow them): sample outside the map as lit.
+///
+/// # Errors
+/// As [`uniform_focused`](crate::uniform_focused); [`WarpError::InvalidOption`];
+/// [`WarpError::EmptyFocusRegion`] when caster and receiver boxes do not overlap in
+/// post-projective light space (nothing visible can be shadowed).
+pub fn xpsm(
+    camera: &Camera,
+    light_direction: Vec3,
+    scene: &crate::FocusScene,
+    options: &XpsmOptions,
+) -> Result<XpsmShadow, WarpError> {
+    options.validate()?;
+    let view = View::camera(camera)?;
+    let f = focus(&view, light_direction, scene)?;
+    let eps_w = f64::from(options.epsilon_w);
+
+    // Step 1: light space, origin at the viewer, light along -Z.
+    let light_space = f.rot * DMat4::from_translation(-view.eye);
+    // Steps 2-3: view vector in light space and its xy direction. The shared light
+    // frame has +Y along V_xy whenever V_xy is not tiny, so unit P = (0, 1); in the
+    // near-parallel band the frame follows the camera's up vector continuously.
+    let v_xy = f.sin_gamma;
+    let thr = f64::from(options.miner_lamp_threshold);
+    let weight = smoothstep(thr, 2.0 * thr, v_xy);
+    let unit_p = glam::DVec2::Y;
+
+    let receivers: ArrayVec<DVec3, 64> = f
+        .receivers
+        .iter()
+        .map(|p| light_space.transform_point3(*p))
+        .collect();
+    let casters: ArrayVec<DVec3, 8> = f
+        .caster_box
+        .corners()
+        .iter()
+        .map(|p| light_space.transform_point3(p.as_dvec3()))
+        .collect();
+    let proj = |p: &DVec3| p.x * unit_p.x + p.y * unit_p.y;
+
+    // Step 4: minimal projections on unit P.
+    let min_casters = casters.iter().map(proj).fold(f64::INFINITY, f64::min);
+    let min_receivers = receivers.iter().map(proj).fold(f64::INFINITY, f64::min);
+    let max_proj = casters
+        .iter()
+        .chain(&receivers)
+        .map(proj)
+        .fold(f64::NEG_INFINITY, f64::max);
+    // Step 5: maximal length of the projection vector (eq. 3).
+    let min_focus = min_casters.max(min_receivers);
+    let scale = scale_of(&receivers).max(scale_of(&casters));
+    let max_length_p = if min_focus < -1e-12 * scale {
+        (eps_w - 1.0) / min_focus
+    } else {
+        f64::INFINITY
+    };
+    // Step 6: optimal length, coef / cos(gamma) with cos(gamma) = |V_xy|.
+    let coef = match options.coef {
+        Some(c) => f64::from(c),
+        None => auto_coef(&f.receivers, &view),
+    };
+    let mut length_p = if weight > 0.0 {
+        weight * coef / v_xy
+    } else {
+        0.0
+    };
+    // Step 7: clip against the back-projection singularity.
+    if max_length_p > 0.0 && length_p > max_length_p {
+        length_p = max_length_p;
+    }
+    // Precision guard: keep the w range of the focus region within MAX_WARP_RATIO.
+    if max_proj > 0.0 {
+        length_p = length_p.min((crate::MAX_WARP_RATIO - 1.0) / max_proj);
+    }
+    // The f32 matrix computes w in world coordinates: keep its rounding small (see
+    // MAX_WARP_RATIO).
+    length_p = length_p.min(crate::MAX_WARP_RATIO / scale_of(&f.casters));
+    if !(length_p.is_finite() && length_p >= 0.0) {
+        length_p = 0.0;
+    }
+    // Steps 8-10: Projection * ZRotation (column-vector form): X = P.xy, Y = P.xy
+    // rotated, w = 1 + lengthP (P.xy).
+    // The paper's ZRotation (rows (Px, Py), (Py, -Px)) is a reflection, right for
+    // D3D's left-handed frame; here the rotation (Px, Py), (-Py, Px) keeps the winding.
+    let rot_z = DMat4::from_cols(
+        DVec4::new(unit_p.x, -unit_p.y, 0.0, 0.0),
+        DVec4::new(unit_p.y, unit_p.x, 0.0, 0.0),
+        DVec4::new(0.0, 0.0, 1.0, 0.0),
+        DVec4::W,
+    );
+    let projection = DMat4::from_cols(
+        DVec4::new(1.0, 0.0, 0.0, unit_p.x * length_p),
+        DVec4::new(0.0, 1.0, 0.0, unit_p.y * length_p),
+        DVec4::new(0.0, 0.0, 1.0, 0.0),
+        DVec4::W,
+    );
+    // ZRotation maps unit P to +X (row 1 of the paper's ZRotation); w is unchanged.
+    let ppls = rot_z * projection;
+    // Step 11: transform into PPLS, clipping by w >= epsilonW.
+    // The points that set maxLengthP land on w = epsilonW itself: classify with a
+    // relative margin so rounding cannot drop them.
+    let eps_clip = eps_w * (1.0 - 1e-9);
+    let caster_cloud = clip_cloud(&ppls, &casters, eps_clip);
+    let receiver_cloud = clip_cloud(&ppls, &receivers, eps_clip);
+    // Step 12: boxes.
+    let cbox = cloud_bounds(&caster_cloud, eps_clip);
+    let rbox = cloud_bounds(&receiver_cloud, eps_clip);
+    let (Some((cxy, cz)), Some((rxy, rz))) = (cbox, rbox) else {
+        return Err(WarpError::EmptyFocusRegion);
+    };
+    // Step 13: focus region = intersection in xy.
+    let mut region = Bounds {
+        min: cxy.min.max(rxy.min),
+        max: cxy.max.min(rxy.max),
+    };
+    // Boxes that touch (a point or a flat receiver inside a flat caster box) may miss
+    // each other by the rounding of f32 input: boxes closer than a relative 1e-4
+    // count as touching (the zero-area focus region is then widened).
+    let slack = 1e-4 * scale_of(&[cxy.min, cxy.max, rxy.min, rxy.max]);
+    for axis in 0..2 {
+        if region.min[axis] > region.max[axis] {
+            if region.min[axis] - region.max[axis] > slack {
+                return Err(WarpError::EmptyFocusRegion);
+            }
+            let mid = 0.5 * (region.min[axis] + region.max[axis]);
+            region.min[axis] = mid;
+            region.max[axis] = mid;
+        }
+    }
+    // Step 14: Z range over both boxes (points with w < epsilonW excluded).
+    region.min.z = cz.0.min(rz.0);
+    region.max.z = cz.1.max(rz.1);
+    let region = region.padded(scale_of(&f.casters));
+    let (min, max) = (region.min, region.max);
+    let ext = max - min;
+    // Step 15: unit cube = inverse of the focus region basis.
+    let unit_cube = DMat4::from_cols(
+        DVec4::new(1.0 / ext.x, 0.0, 0.0, 0.0),
+        DVec4::new(0.0, 1.0 / ext.y, 0.0, 0.0),
+        DVec4::new(0.0, 0.0, 1.0 / ext.z, 0.0),
+        DVec4::new(-min.x / ext.x, -min.y / ext.y, -min.z / ext.z, 1.0),
+    );
+    // Step 16: normalized space, WebGPU: x, y to [-1, 1]; the unit-cube z grows toward
+    // the light, so standard depth is 1 - z and reversed-Z depth is z.
+    let normalized = if options.reversed_z {
+        DMat4::from_cols(
+            DVec4::new(2.0, 0.0, 0.0, 0.0),
+            DVec4::new(0.0, 2.0, 0.0, 0.0),
+            DVec4::new(0.0, 0.0, 1.0, 0.0),
+            DVec4::new(-1.0, -1.0, 0.0, 1.0),
+        )
+    } else {
+        DMat4::from_cols(
+            DVec4::new(2.0, 0.0, 0.0, 0.0),
+            DVec4::new(0.0, 2.0, 0.0, 0.0),
+            DVec4::new(0.0, 0.0, -1.0, 0.0),
+            DVec4::new(-1.0, -1.0, 1.0, 1.0),
+        )
+    };
+    // Step 17: the final transformation (View * LightSpace folded into light_space).
+    let clip = normalized * unit_cube * ppls * light_space;
+    let transform = finish(f.rot, clip, options.reversed_z, f.light)?;
+    // Step 18: Z bias scale, 1 / (MaxZ - MinZ).
+    let z_bias_scale = (1.0 / ext.z) as f32;
+    if !(z_bias_scale.is_finite() && z_bias_scale > 0.0) {
+        return Err(WarpError::Degenerate);
+    }
+    Ok(XpsmShadow {
+        transform,
+        z_bias_scale,
+        length_p: length_p as f32,
+        max_length_p: max_length_p as f32,
+        warp_weight: weight as f32,
+    })
+}
+
+/// `1 / sqrt(z_n z_f)` over the visible receivers' view depths.
+fn auto_coef(receivers: &[DVec3], view: &View) -> f64 {
+    let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in receivers {
+        let d = (*p - view.eye).dot(view.forward);
+        z_n = z_n.min(d);
+        z_f = z_f.max(d);
+    }
+    let z_scale = z_f.abs().max(z_n.abs()).max(f64::MIN_POSITIVE);
+    let z_n = z_n.max(1e-6 * z_scale);
+    let z_f = z_f.max(z_n);
+    let c = 1.0 / sqrt0(z_n * z_f);
+    if c.is_finite() { c } else { 0.0 }
+}
+
+/// PPLS points of a vertex set, split by the plane `w = eps_w`: every vertex (those
+/// behind flagged by `w < eps_w`), plus the crossing of every segment between a
+/// vertex in front and one behind (a superset of the clipped hull's vertices).
+fn clip_cloud(ppls: &DMat4, points: &[DVec3], eps_w: f64) -> Cloud {
+    let mut out = Cloud::new();
+    let hom: ArrayVec<Hom, 64> = points.iter().map(|p| *ppls * p.extend(1.0)).collect();
+    for h in &hom {
+        let _ = out.try_push(*h);
+    }
+    for a in hom.iter().filter(|h| h.w >= eps_w) {
+        for b in hom.iter().filter(|h| h.w < eps_w) {
+            let t = (a.w - eps_w) / (a.w - b.w);
+            let mut c = *a + (*b - *a) * t;
+            c.w = eps_w;
+            let _ = out.try_push(c);
+        }
+    }
+    out
+}
+
+/// The xy box (all points, `w` raised to at least `eps_w`) and the z range (points
+/// with `w >= eps_w` only) of a cloud; `None` when no point has `w >= eps_w`.
+fn cloud_bounds(cloud: &Cloud, eps_w: f64) -> Option<(Bounds, (f64, f64))> {
+    let mut xy = Bounds::EMPTY;
+    let (mut z0, mut z1) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut any = false;
+    for h in cloud {
+        let w = h.w.max(eps_w);
+        xy.add(DVec3::new(h.x / w, h.y / w, 0.0));
+        if h.w >= eps_w {
+            any = true;
+            z0 = z0.min(h.z / h.w);
+            z1 = z1.max(h.z / h.w);
+        }
+    }
+    (any && xy.min.is_finite() && xy.max.is_finite() && z0.is_finite() && z1.is_finite())
+        .then_some((xy, (z0, z1)))
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use shadowmap_frustum::{Aabb, Camera, Projection, ShadowMapping};
+
+    use super::*;
+    use crate::FocusScene;
+
+    fn camera() -> Camera {
+        Camera::look_to(
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(0.0, -0.2, -1.0),
+            Vec3::Y,
+            Projection::perspective(1.0, 1.5, 0.5, 100.0),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn miner_lamp_is_orthographic() {
+        let cam = camera();
+        let scene = FocusScene::whole(Aabb::new(Vec3::splat(-150.0), Vec3::splat(150.0)));
+        let x = xpsm(&cam, cam.forward(), &scene, &XpsmOptions::default()).unwrap();
+        assert_eq!(x.warp_weight, 0.0);
+        assert_eq!(x.length_p, 0.0);
+        let m = x.transform.clip_from_world;
+        assert_eq!(
+            glam::Vec4::new(m.x_axis.w, m.y_axis.w, m.z_axis.w, m.w_axis.w),
+            glam::Vec4::W
+        );
+    }
+
+    #[test]
+    fn casters_behind_the_viewer_clip_the_projection_vector() {
+        // Light from behind the camera; the caster box reaches far behind the viewer
+        // (the camera is inside the caster volume).
+        let cam = camera();
+        let receivers = Aabb::new(Vec3::new(-100.0, -1.0, -100.0), Vec3::new(100.0, 0.0, 0.0));
+        let casters = Aabb::new(
+            Vec3::new(-100.0, -1.0, -100.0),
+            Vec3::new(100.0, 30.0, 400.0),
+        );
+        let scene = FocusScene::new(receivers, casters);
+        let light = Vec3::new(0.1, -0.6, -1.0);
+        let o = XpsmOptions::default().with_coef(10.0);
+        let x = xpsm(&cam, light, &scene, &o).unwrap();
+        assert!(x.max_length_p.is_finite() && x.max_length_p > 0.0, "{x:?}");
+        assert_eq!(x.length_p, x.max_length_p);
+        // Every visible receiver keeps w >= epsilonW and lands in the map.
+        let body =
+            shadowmap_frustum::ConvexBody::from_frustum_aabb(&cam.frustum().unwrap(), &receivers)
+                .unwrap();
+        let m = x.transform.clip_from_world.as_dmat4();
+        for v in body.vertices() {
+            let h = m * v.as_dvec3().extend(1.0);
+            assert!(h.w >= 0.1 * (1.0 - 1e-5), "w = {}", h.w);
+            let s = x.transform.map_point(v.as_dvec3()).unwrap();
+            assert!(
+                (-1e-4..=1.0001).contains(&s.uv.x) && (-1e-4..=1.0001).contains(&s.uv.y),
+                "{s:?}"
+            );
+        }
+        // Without the casters behind, the same coef is not clipped.
+        let front = FocusScene::new(
+            receivers,
+            Aabb::new(receivers.min, Vec3::new(100.0, 30.0, 0.0)),
+        );
+        let y = xpsm(&cam, light, &front, &o).unwrap();
+        assert!(y.length_p >= x.length_p);
+    }
+
+    #[test]
+    fn disjoint_boxes_have_no_focus_region() {
+        let cam = camera();
+        let receivers = Aabb::new(Vec3::new(-10.0, -1.0, -50.0), Vec3::new(10.0, 0.0, -1.0));
+        let casters = Aabb::new(Vec3::new(500.0, 0.0, -50.0), Vec3::new(510.0, 5.0, -40.0));
+        let r = xpsm(
+            &cam,
+            Vec3::NEG_Y,
+            &FocusScene::new(receivers, casters),
+            &XpsmOptions::default(),
+        );
+        assert_eq!(r.err(), Some(WarpError::EmptyFocusRegion));
+        for bad in [
+            XpsmOptions::default().with_epsilon_w(0.0),
+            XpsmOptions::default().with_coef(f32::NAN),
+        ] {
+            let r = xpsm(&cam, Vec3::NEG_Y, &FocusScene::whole(receivers), &bad);
+            assert_eq!(r.err(), Some(WarpError::InvalidOption));
+        }
+    }
+}
