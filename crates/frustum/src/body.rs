@@ -4,11 +4,16 @@ use glam::{DVec3, Vec3};
 use crate::geometry::DPlane;
 use crate::{Aabb, Frustum, FrustumError};
 
-/// Most vertices a [`ConvexBody`] holds: twice the 20 vertices a polyhedron of 12
-/// planes can have, so an extruded frustum-box intersection always fits.
+/// Most vertices a [`ConvexBody`] holds.
 pub const MAX_BODY_VERTICES: usize = 64;
 
-/// A convex polyhedron given by its vertices (fixed capacity, no heap allocation).
+/// Most bounding planes a [`ConvexBody`] keeps: the 12 of a frustum-box intersection,
+/// or, after extrusion, its light-facing planes, one plane per silhouette edge, and
+/// the scene box.
+const MAX_BODY_PLANES: usize = 48;
+
+/// A convex polyhedron: its vertices and the half-spaces that bound it (fixed
+/// capacity, no heap allocation).
 ///
 /// Built as a frustum intersected with a box, optionally extruded toward a
 /// directional light and clipped by a scene box: the body `B` of LiSPSM
@@ -16,6 +21,9 @@ pub const MAX_BODY_VERTICES: usize = 64;
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConvexBody {
     vertices: ArrayVec<Vec3, MAX_BODY_VERTICES>,
+    planes: ArrayVec<DPlane, MAX_BODY_PLANES>,
+    /// Rounding scale of the coordinates (largest magnitude involved).
+    scale: f64,
 }
 
 impl ConvexBody {
@@ -50,45 +58,63 @@ impl ConvexBody {
         aabb: &Aabb,
     ) -> Result<Self, FrustumError> {
         let aabb = aabb.validate()?;
-        let mut planes = [fplanes[0]; 12];
-        planes[..6].copy_from_slice(fplanes);
-        for (dst, p) in planes[6..].iter_mut().zip(aabb.planes()) {
-            *dst = DPlane::from_plane(&p);
-        }
         let scale = corners
             .iter()
             .chain(&aabb.corners())
             .map(|c| c.abs().max_element())
             .fold(0.0f32, f32::max)
             .max(f32::MIN_POSITIVE);
-        let mut body = Self {
-            vertices: ArrayVec::new(),
-        };
-        let scale = f64::from(scale);
+        let mut planes = ArrayVec::new();
+        planes.extend(fplanes.iter().copied());
+        planes.extend(aabb.planes().iter().map(DPlane::from_plane));
+        Ok(Self::from_planes(planes, f64::from(scale)))
+    }
+
+    /// The vertices of the region bounded by `planes`: every triple intersection that
+    /// lies inside all of them.
+    fn from_planes(planes: ArrayVec<DPlane, MAX_BODY_PLANES>, scale: f64) -> Self {
         // The corners are f32, so a frustum face is planar only to about f32 epsilon
         // times the scale: accept vertices that far outside, and merge closer ones.
         let inside_tol = 8.0 * f64::from(f32::EPSILON) * scale;
         let merge_tol = 2.0 * inside_tol;
-        for i in 0..12 {
-            for j in i + 1..12 {
-                for k in j + 1..12 {
-                    let Some(p) = intersect3(&planes[i], &planes[j], &planes[k]) else {
+        let mut body = Self {
+            vertices: ArrayVec::new(),
+            planes,
+            scale,
+        };
+        let n = body.planes.len();
+        for i in 0..n {
+            for j in i + 1..n {
+                for k in j + 1..n {
+                    let (a, b, c) = (&body.planes[i], &body.planes[j], &body.planes[k]);
+                    let Some(p) = intersect3(a, b, c) else {
                         continue;
                     };
-                    if planes.iter().all(|pl| pl.distance(p) >= -inside_tol) {
+                    if body.planes.iter().all(|pl| pl.distance(p) >= -inside_tol) {
                         body.push_unique(p, merge_tol);
                     }
                 }
             }
         }
-        Ok(body)
+        body
     }
 
-    /// The body extruded toward a directional light and clipped by `scene`: every
-    /// vertex `v` adds the point where the ray from `v` toward the light leaves the
-    /// scene box. `light_direction` is the direction the light travels.
+    /// The part of the scene from which light reaches the body: every point `x` of
+    /// `scene` such that `x - t u` lies in the body for some `t >= 0`, with `u` the
+    /// unit direction toward the light (`-light_direction`). Casters that shadow the
+    /// body lie in it.
     ///
-    /// Casters that shadow the body lie in the convex hull of the result.
+    /// Exact, by eliminating `t` (Fourier-Motzkin): with inward planes
+    /// `n_i . x + d_i >= 0` of the body and `a_i = n_i . u`,
+    ///
+    /// ```text
+    /// keep       n_i . x + d_i >= 0                                   for a_i >= 0
+    /// add        (a_i n_j - a_j n_i) . x + (a_i d_j - a_j d_i) >= 0    for a_i > 0 > a_j
+    /// ```
+    ///
+    /// then clip by the scene box. A pair plane is parallel to `u`; only pairs that
+    /// share an edge of the body (its silhouette) are needed, and any pair plane is a
+    /// valid bound, so the edge test only saves work.
     ///
     /// # Errors
     /// [`FrustumError::NonFinite`], [`FrustumError::ZeroDirection`],
@@ -102,21 +128,75 @@ impl ConvexBody {
         if !light_direction.is_finite() {
             return Err(FrustumError::NonFinite);
         }
-        let to_light = (-light_direction.as_dvec3())
+        let u = (-light_direction.as_dvec3())
             .try_normalize()
             .ok_or(FrustumError::ZeroDirection)?;
-        let (lo, hi) = (scene.min.as_dvec3(), scene.max.as_dvec3());
-        let scale = f64::from(scene.min.abs().max(scene.max.abs()).max_element()).max(1e-30);
-        let mut out = self.clone();
-        for v in &self.vertices {
-            let v = v.as_dvec3();
-            let t = ray_exit(v, to_light, lo, hi);
-            if t > 1e-9 * scale {
-                let p = (v + to_light * t).clamp(lo, hi);
-                out.push_unique(p, 1e-7 * scale);
+        let scale = self.scale.max(f64::from(
+            scene.min.abs().max(scene.max.abs()).max_element(),
+        ));
+        if self.is_empty() {
+            return Ok(Self {
+                vertices: ArrayVec::new(),
+                planes: ArrayVec::new(),
+                scale,
+            });
+        }
+        let tol = 8.0 * f64::from(f32::EPSILON) * scale;
+        // A plane whose normal turns away from the light by less than this sweeps
+        // less than `tol` across the scene: treat it as parallel.
+        let extent = f64::from(scene.size().length()).max(1e-30);
+        let parallel = tol / extent;
+        // Which planes each vertex lies on, to find the body's edges.
+        let tight: ArrayVec<u64, MAX_BODY_VERTICES> = self
+            .vertices
+            .iter()
+            .map(|v| {
+                let v = v.as_dvec3();
+                self.planes
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, p)| p.distance(v).abs() <= 4.0 * tol)
+                    .fold(0u64, |m, (i, _)| m | (1 << i))
+            })
+            .collect();
+        let shares_edge = |i: usize, j: usize| {
+            let both = (1u64 << i) | (1u64 << j);
+            tight.iter().filter(|m| *m & both == both).count() >= 2
+        };
+        // The vertices were accepted up to the construction tolerance: relax the planes
+        // by as much, so every vertex is inside the region that is swept.
+        let relax = 8.0 * f64::from(f32::EPSILON) * self.scale;
+        let body_planes: ArrayVec<DPlane, MAX_BODY_PLANES> = self
+            .planes
+            .iter()
+            .map(|p| DPlane {
+                normal: p.normal,
+                d: p.d + relax,
+            })
+            .collect();
+        let mut planes: ArrayVec<DPlane, MAX_BODY_PLANES> = ArrayVec::new();
+        let a: ArrayVec<f64, MAX_BODY_PLANES> =
+            body_planes.iter().map(|p| p.normal.dot(u)).collect();
+        for (i, p) in body_planes.iter().enumerate() {
+            if a[i] >= -parallel {
+                push_plane(&mut planes, *p);
             }
         }
-        Ok(out)
+        for i in 0..body_planes.len() {
+            for j in 0..body_planes.len() {
+                if a[i] > parallel && a[j] < -parallel && shares_edge(i, j) {
+                    let (pi, pj) = (&body_planes[i], &body_planes[j]);
+                    let normal = pj.normal * a[i] - pi.normal * a[j];
+                    if normal.length_squared() > 0.0 {
+                        push_plane(&mut planes, DPlane::new(normal, pj.d * a[i] - pi.d * a[j]));
+                    }
+                }
+            }
+        }
+        for p in scene.planes() {
+            push_plane(&mut planes, DPlane::from_plane(&p));
+        }
+        Ok(Self::from_planes(planes, scale))
     }
 
     /// The vertices.
@@ -129,6 +209,18 @@ impl ConvexBody {
     #[must_use]
     pub fn is_empty(&self) -> bool {
         self.vertices.is_empty()
+    }
+
+    /// Whether `p` lies inside every bounding plane, allowing `tolerance` world units.
+    /// Always `false` for an empty body.
+    #[must_use]
+    pub fn contains(&self, p: Vec3, tolerance: f32) -> bool {
+        let p = p.as_dvec3();
+        !self.is_empty()
+            && self
+                .planes
+                .iter()
+                .all(|pl| pl.distance(p) >= -f64::from(tolerance))
     }
 
     /// The box around the vertices, `None` when empty.
@@ -147,10 +239,23 @@ impl ConvexBody {
             .iter()
             .any(|v| (v.as_dvec3() - p).abs().max_element() <= tol);
         if !dup {
-            // Capacity is a proven bound (see MAX_BODY_VERTICES); ignore overflow rather
-            // than panic if rounding ever produced near-duplicates beyond it.
+            // A polyhedron with F faces has at most 2F - 4 vertices, which the
+            // capacities allow; ignore overflow rather than panic if rounding ever
+            // produced near-duplicates beyond it.
             let _ = self.vertices.try_push(p32);
         }
+    }
+}
+
+/// Adds a plane unless an equal one is already there (or there is no room: the
+/// capacity covers every plane the builders produce).
+fn push_plane(planes: &mut ArrayVec<DPlane, MAX_BODY_PLANES>, p: DPlane) {
+    let same = planes.iter().any(|q| {
+        (q.normal - p.normal).length_squared() < 1e-24
+            && (q.d - p.d).abs() < 1e-12 * p.d.abs().max(1.0)
+    });
+    if !same {
+        let _ = planes.try_push(p);
     }
 }
 
@@ -163,18 +268,4 @@ fn intersect3(a: &DPlane, b: &DPlane, c: &DPlane) -> Option<DVec3> {
     }
     let p = (bc * -a.d + c.normal.cross(a.normal) * -b.d + a.normal.cross(b.normal) * -c.d) / det;
     p.is_finite().then_some(p)
-}
-
-/// Distance along `dir` at which a ray from `origin` (inside the box) leaves it.
-fn ray_exit(origin: DVec3, dir: DVec3, lo: DVec3, hi: DVec3) -> f64 {
-    let mut t = f64::INFINITY;
-    for axis in 0..3 {
-        let d = dir[axis];
-        if d > 1e-15 {
-            t = t.min((hi[axis] - origin[axis]) / d);
-        } else if d < -1e-15 {
-            t = t.min((lo[axis] - origin[axis]) / d);
-        }
-    }
-    if t.is_finite() { t.max(0.0) } else { 0.0 }
 }

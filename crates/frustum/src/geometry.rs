@@ -186,7 +186,7 @@ impl Sphere {
 }
 
 /// A plane in `f64`, used inside the builders.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct DPlane {
     pub(crate) normal: DVec3,
     pub(crate) d: f64,

@@ -519,12 +519,35 @@ fn extruded_body_reaches_the_scene_boundary_toward_the_light() {
     let scene = Aabb::new(Vec3::new(-30.0, 0.0, -30.0), Vec3::new(30.0, 50.0, 5.0));
     let body = ConvexBody::from_frustum_aabb(&frustum, &scene).unwrap();
     let ext = body.extruded_toward_light(Vec3::NEG_Y, &scene).unwrap();
-    assert!(ext.vertices().len() > body.vertices().len());
-    // Straight up from every body vertex lies a vertex at the scene top.
+    // The body and everything straight above it (toward the light) is inside; a
+    // scene corner no ray from the body reaches is not.
     for v in body.vertices() {
-        assert!(ext.vertices().iter().any(|e| (e.x - v.x).abs() < 1e-4
-            && (e.z - v.z).abs() < 1e-4
-            && (e.y - 50.0).abs() < 1e-4));
+        assert!(ext.contains(*v, 1e-3));
+        assert!(ext.contains(Vec3::new(v.x, 49.9, v.z), 1e-3), "{v}");
+    }
+    assert!(!ext.contains(Vec3::new(-30.0, 50.0, 5.0), 1e-3));
+    // The top face is the silhouette seen from above: a vertex at the scene top sits
+    // straight above the outermost body vertices.
+    let top = ext
+        .vertices()
+        .iter()
+        .filter(|e| (e.y - 50.0).abs() < 1e-3)
+        .count();
+    assert!(top >= 3, "{:?}", ext.vertices());
+
+    // A grazing light: rays leave through the side of the scene box, and the swept
+    // region reaches the box edges between the exits (a hull of the exit points
+    // alone would miss them).
+    let light = Vec3::new(1.0, -0.02, 0.0);
+    let ext = body.extruded_toward_light(light, &scene).unwrap();
+    let toward = -light.normalize();
+    for v in body.vertices() {
+        for t in [0.0, 5.0, 20.0, 45.0] {
+            let x = *v + toward * t;
+            if scene.contains(x) {
+                assert!(ext.contains(x, 1e-3), "{x} (from {v}, t = {t})");
+            }
+        }
     }
     assert_eq!(
         body.extruded_toward_light(Vec3::ZERO, &scene),

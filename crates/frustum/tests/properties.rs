@@ -12,18 +12,6 @@ use shadowmap_testgen::{
     log_uniform, strategy, unit_vec3,
 };
 
-/// 1,000 cases from a fixed seed, so CI is reproducible; the fuzz targets explore
-/// the same generators without one. `PROPTEST_RNG_SEED` overrides nothing here: to
-/// explore, change the seed or run the fuzzers.
-fn config() -> ProptestConfig {
-    ProptestConfig {
-        cases: 1000,
-        failure_persistence: None,
-        rng_seed: proptest::test_runner::RngSeed::Fixed(0x05AD_03A9),
-        ..ProptestConfig::default()
-    }
-}
-
 /// A valid cascade request: camera, light, splits and options.
 #[derive(Clone, Debug)]
 struct FitCase {
@@ -80,7 +68,7 @@ fn f32_tolerance(m: &Mat4, coord: f64) -> [f64; 3] {
 }
 
 proptest! {
-    #![proptest_config(config())]
+    #![proptest_config(shadowmap_testgen::proptest_config())]
 
     /// Every point of a slice (corners and interior points) maps inside its cascade's
     /// `[0, 1]² x [0, 1]`, for tight and stable fits, either depth convention.

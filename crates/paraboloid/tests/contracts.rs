@@ -8,7 +8,7 @@ use shadowmap_testgen::paraboloid::{
 use shadowmap_testgen::strategy;
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(1000))]
+    #![proptest_config(shadowmap_testgen::proptest_config())]
 
     /// `IpsmPlan::new` on anything: a typed error or a finite, covering plan.
     #[test]

@@ -30,7 +30,7 @@ fn border_directions(input: &PlanInput) -> Option<(IpsmPlan, Vec<Vec3>)> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(1000))]
+    #![proptest_config(shadowmap_testgen::proptest_config())]
 
     /// Every frustum border point lies inside the fitted cone, for both fits, both as
     /// fitted by the plan and by the stand-alone functions.

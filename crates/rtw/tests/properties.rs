@@ -60,7 +60,7 @@ fn reference_density(src: &[f32], radius: u32, floor: f32) -> Vec<f64> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(1000))]
+    #![proptest_config(shadowmap_testgen::proptest_config())]
 
     /// The builder's contract on valid input: tables zero at the ends, knots
     /// non-decreasing, forward warp monotone and onto [0, 1], inverse exact,

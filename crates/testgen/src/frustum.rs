@@ -308,9 +308,32 @@ pub fn check_convex_body(case: &BodyCase) {
         assert!(grown.contains(*v), "{v} outside the box");
     }
     if let Ok(ext) = body.extruded_toward_light(case.light, &case.aabb) {
-        assert!(ext.vertices().len() >= body.vertices().len());
         let grown = Aabb::new(case.aabb.min - tol, case.aabb.max + tol);
-        assert!(ext.vertices().iter().all(|v| grown.contains(*v)));
+        assert!(
+            ext.vertices()
+                .iter()
+                .all(|v| v.is_finite() && grown.contains(*v))
+        );
+        // Every point the light reaches the body from is inside: sample rays from the
+        // body's vertices and centroid toward the light, up to the scene boundary.
+        if body.is_empty() {
+            return;
+        }
+        let toward = -case.light.normalize();
+        let n = body.vertices().len() as f32;
+        let centroid = body.vertices().iter().fold(Vec3::ZERO, |s, v| s + *v) / n;
+        let reach = case.aabb.size().length();
+        for start in body.vertices().iter().chain([&centroid]) {
+            for f in [0.0, 0.1, 0.35, 0.7, 1.0] {
+                let x = *start + toward * (f * reach);
+                if case.aabb.contains(x) {
+                    assert!(
+                        ext.contains(x, 4.0 * tol),
+                        "{x} from {start} not in the extrusion"
+                    );
+                }
+            }
+        }
     }
 }
 

@@ -247,7 +247,7 @@ fn check_motion(
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(1000))]
+    #![proptest_config(shadowmap_testgen::proptest_config())]
 
     #[test]
     fn uniform_covers_receivers_and_casters(case in strategy(warp_case), b in bytes()) {
