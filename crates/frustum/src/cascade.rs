@@ -3,7 +3,7 @@ use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
 
 use crate::body::ConvexBody;
 use crate::camera::CameraGeometry;
-use crate::light::{light_from_world_rotation, unit};
+use crate::light::unit;
 use crate::mapping::{LightDirection, ShadowSample, ShadowTransform, project_dmat};
 use crate::split::CascadeBlend;
 use crate::{Aabb, Camera, CascadeSplits, FrustumError, MAX_CASCADES, ShadowMapping, math};
@@ -254,7 +254,7 @@ impl Fitter {
         Ok(Self {
             camera,
             light_dir,
-            light_from_world: light_from_world_rotation(light_dir, options.up_hint)?,
+            light_from_world: crate::projection::light_rotation(light_dir, options.up_hint),
             options: *options,
             scene,
         })

@@ -1,4 +1,4 @@
-use glam::{DMat4, DVec3, Vec3};
+use glam::{DVec3, Vec3};
 
 use crate::FrustumError;
 
@@ -103,42 +103,5 @@ pub fn directional_light_from_world(
     direction: Vec3,
     up_hint: Vec3,
 ) -> Result<glam::Mat4, FrustumError> {
-    light_from_world_rotation(unit(direction)?, up_hint).map(|m| m.as_mat4())
-}
-
-pub(crate) fn light_from_world_rotation(dir: DVec3, up_hint: Vec3) -> Result<DMat4, FrustumError> {
-    let up = if up_hint.is_finite() {
-        up_hint.as_dvec3().try_normalize()
-    } else {
-        None
-    };
-    let up = match up {
-        Some(u) if dir.cross(u).length() > 1e-3 => u,
-        _ => least_aligned_axis(dir),
-    };
-    Ok(look_to_rh(DVec3::ZERO, dir, up))
-}
-
-pub(crate) fn least_aligned_axis(dir: DVec3) -> DVec3 {
-    let a = dir.abs();
-    if a.x <= a.y && a.x <= a.z {
-        DVec3::X
-    } else if a.y <= a.z {
-        DVec3::Y
-    } else {
-        DVec3::Z
-    }
-}
-
-/// `view_from_world` looking from `eye` along unit `dir`, `up` not parallel to `dir`.
-pub(crate) fn look_to_rh(eye: DVec3, dir: DVec3, up: DVec3) -> DMat4 {
-    let f = dir;
-    let s = f.cross(up).normalize();
-    let u = s.cross(f);
-    DMat4::from_cols(
-        glam::DVec4::new(s.x, u.x, -f.x, 0.0),
-        glam::DVec4::new(s.y, u.y, -f.y, 0.0),
-        glam::DVec4::new(s.z, u.z, -f.z, 0.0),
-        glam::DVec4::new(-eye.dot(s), -eye.dot(u), eye.dot(f), 1.0),
-    )
+    Ok(crate::projection::light_rotation(unit(direction)?, up_hint).as_mat4())
 }

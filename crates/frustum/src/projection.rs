@@ -12,7 +12,7 @@
 //! Reversed-Z swaps the roles of `n` and `f` in the depth row, giving depth 1 at the
 //! near plane and 0 at the far plane.
 
-use glam::{DMat4, DVec4};
+use glam::{DMat4, DVec3, DVec4, Vec3};
 
 use crate::math;
 
@@ -85,4 +85,50 @@ pub fn perspective_infinite(fov_y: f64, aspect: f64, near: f64, reversed_z: bool
         DVec4::new(0.0, 0.0, a, -1.0),
         DVec4::new(0.0, 0.0, b, 0.0),
     )
+}
+
+/// `view_from_world` looking from `eye` along the unit direction `dir`, with `up` not
+/// parallel to `dir` (right-handed, the view looks down `-Z`).
+#[must_use]
+pub fn look_to(eye: DVec3, dir: DVec3, up: DVec3) -> DMat4 {
+    let f = dir;
+    let s = f.cross(up).normalize();
+    let u = s.cross(f);
+    DMat4::from_cols(
+        DVec4::new(s.x, u.x, -f.x, 0.0),
+        DVec4::new(s.y, u.y, -f.y, 0.0),
+        DVec4::new(s.z, u.z, -f.z, 0.0),
+        DVec4::new(-eye.dot(s), -eye.dot(u), eye.dot(f), 1.0),
+    )
+}
+
+/// The world axis least aligned with `dir`: an up vector that is never parallel to it.
+#[must_use]
+pub fn least_aligned_axis(dir: DVec3) -> DVec3 {
+    let a = dir.abs();
+    if a.x <= a.y && a.x <= a.z {
+        DVec3::X
+    } else if a.y <= a.z {
+        DVec3::Y
+    } else {
+        DVec3::Z
+    }
+}
+
+/// Rotation-only light frame looking along the unit direction `dir`, oriented by
+/// `up_hint`; when the hint is non-finite, zero or within about 1e-3 rad of `dir`,
+/// the world axis least aligned with `dir` orients it instead. It depends only on its
+/// arguments, so frames built from it are stable as the camera moves.
+#[must_use]
+pub fn light_rotation(dir: DVec3, up_hint: Vec3) -> DMat4 {
+    let up = if up_hint.is_finite() {
+        up_hint.as_dvec3().try_normalize()
+    } else {
+        None
+    };
+    let up = match up {
+        Some(u) if dir.cross(u).length() > 1e-3 => u,
+        _ => least_aligned_axis(dir),
+    };
+    look_to(DVec3::ZERO, dir, up)
 }

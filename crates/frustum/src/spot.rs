@@ -1,6 +1,7 @@
 use crate::body::ConvexBody;
-use crate::light::{least_aligned_axis, look_to_rh, unit};
+use crate::light::unit;
 use crate::mapping::{LightDirection, ShadowTransform};
+use crate::projection::{least_aligned_axis, look_to};
 use crate::{Frustum, FrustumError, Light, SceneBounds, math};
 
 /// A perspective shadow map for a spot light, fitted to what the camera sees.
@@ -45,7 +46,7 @@ pub fn fit_spot(
     let dir = unit(direction)?;
     let pos = position.as_dvec3();
     let up = least_aligned_axis(dir);
-    let light_from_world = look_to_rh(pos, dir, up);
+    let light_from_world = look_to(pos, dir, up);
     let cone_tan = math::tan(f64::from(half_angle));
     let range = f64::from(range);
     let near_min = range * 1e-4;

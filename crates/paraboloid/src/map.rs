@@ -1,6 +1,6 @@
 //! The paraboloid map (Brabec et al.): forward and inverse maps, density, usable disc.
 
-use glam::{DMat4, DVec2, DVec3, DVec4, Mat4, Vec2, Vec3};
+use glam::{DMat4, DVec2, DVec3, Mat4, Vec2, Vec3};
 use shadowmap_frustum::{ShadowMapping, ShadowSample, math};
 
 use crate::ParaboloidError;
@@ -213,7 +213,7 @@ impl ParaboloidMap {
             .try_normalize()
             .filter(|d| d.length_squared() > 0.5)
             .ok_or(ParaboloidError::ZeroDirection)?;
-        let rot = look_to_rh(dir, options.up_hint);
+        let rot = shadowmap_frustum::projection::light_rotation(dir, options.up_hint);
         let light_from_world = rot * DMat4::from_translation(-position.as_dvec3());
         if !light_from_world.as_mat4().is_finite() {
             return Err(ParaboloidError::NonFinite);
@@ -477,37 +477,6 @@ pub(crate) fn check_depth_range(near: f32, far: f32) -> Result<(), ParaboloidErr
     } else {
         Err(ParaboloidError::InvalidDepthRange { near, far })
     }
-}
-
-/// Rotation-only `light_from_world` looking along unit `dir`.
-fn look_to_rh(dir: DVec3, up_hint: Vec3) -> DMat4 {
-    let up = if up_hint.is_finite() {
-        up_hint.as_dvec3().try_normalize()
-    } else {
-        None
-    };
-    let up = match up {
-        Some(u) if dir.cross(u).length() > 1e-3 => u,
-        _ => {
-            let a = dir.abs();
-            if a.x <= a.y && a.x <= a.z {
-                DVec3::X
-            } else if a.y <= a.z {
-                DVec3::Y
-            } else {
-                DVec3::Z
-            }
-        }
-    };
-    let f = dir;
-    let s = f.cross(up).normalize();
-    let u = s.cross(f);
-    DMat4::from_cols(
-        DVec4::new(s.x, u.x, -f.x, 0.0),
-        DVec4::new(s.y, u.y, -f.y, 0.0),
-        DVec4::new(s.z, u.z, -f.z, 0.0),
-        DVec4::W,
-    )
 }
 
 #[cfg(test)]
