@@ -859,8 +859,9 @@ fn markdown(report: &Report) -> String {
         "Limits beside every table: pixel-matched `m = 1` (so `S = texels / visible \
          pixels` at best for a map that matches the screen), the logarithmic bound \
          `K ln(f/n)` on Lloyd's storage factor of separable parameterizations \
-         (`K = 1 / (2 tan(fovY/2))`), and the RTW oracle row (RTW fed the exact required \
-         density; directional lights only).\n\n",
+         (`K = 1 / (2 tan(fovY/2))`), and the RTW oracle row (RTW fed the exact \
+         perspective-only density each texture axis requires, measured on the same \
+         visible pixels; directional lights only).\n\n",
     );
     s.push_str(
         "Heatmaps: `m` on a logarithmic scale from 1 (dark blue) to 10 (yellow), \

@@ -29,7 +29,7 @@ use shadowmap_paraboloid::{
     subdivide_triangles,
 };
 use shadowmap_rtw::{
-    EyeSample, ImportanceMap, ImportanceOptions, RtwShadow, WarpMaps, WarpOptions,
+    EyeSample, ImportanceMap, ImportanceOptions, OracleAxis, RtwShadow, WarpMaps, WarpOptions,
 };
 use shadowmap_warp::{
     FocusScene, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
@@ -62,7 +62,8 @@ pub enum TechniqueKind {
     /// Rectilinear texture warping over the uniform fit, importance from the eye's
     /// samples (backward analysis).
     Rtw,
-    /// RTW fed the exact required density (`ImportanceMap::accumulate_oracle`).
+    /// RTW fed the exact perspective-only density each axis requires
+    /// (`ImportanceMap::accumulate_oracle_axis`, `WarpMaps::build_separable`).
     RtwOracle,
     /// Perspective fit of a spot light (`shadowmap_frustum::fit_spot`).
     SpotFit,
@@ -384,6 +385,7 @@ impl Technique {
                     .map_err(|x| e(&x))?;
                 let n = options.rtw_importance_side;
                 let mut map = ImportanceMap::new(n, n).map_err(|x| e(&x))?;
+                let mut warps = Box::new(WarpMaps::new(n, n).map_err(|x| e(&x))?);
                 if kind == TechniqueKind::Rtw {
                     map.accumulate_backward(
                         &base,
@@ -392,19 +394,38 @@ impl Technique {
                         &ImportanceOptions::default(),
                     )
                     .map_err(|x| e(&x))?;
+                    warps
+                        .build(&map, &WarpOptions::default())
+                        .map_err(|x| e(&x))?;
                 } else {
-                    map.accumulate_oracle(
-                        &base,
-                        camera,
-                        frame.pixels_per_radian,
-                        frame.eye_samples,
-                    )
-                    .map_err(|x| e(&x))?;
+                    // The oracle of a separable warp: each axis gets the density that
+                    // axis needs (an isotropic requirement would spend texels on the
+                    // axis that does not need them). Perspective-only (zero normal):
+                    // true-normal requirements of surfaces seen edge-on are unbounded
+                    // and, once normalized, starve the rest of the map.
+                    let mut map_v = ImportanceMap::new(n, n).map_err(|x| e(&x))?;
+                    let flat: Vec<EyeSample> = frame
+                        .eye_samples
+                        .iter()
+                        .map(|s| EyeSample {
+                            normal: glam::Vec3::ZERO,
+                            ..*s
+                        })
+                        .collect();
+                    for (axis, m) in [(OracleAxis::U, &mut map), (OracleAxis::V, &mut map_v)] {
+                        m.accumulate_oracle_axis(
+                            axis,
+                            &base,
+                            camera,
+                            frame.pixels_per_radian,
+                            &flat,
+                        )
+                        .map_err(|x| e(&x))?;
+                    }
+                    warps
+                        .build_separable(&map, &map_v, &WarpOptions::default())
+                        .map_err(|x| e(&x))?;
                 }
-                let mut warps = Box::new(WarpMaps::new(n, n).map_err(|x| e(&x))?);
-                warps
-                    .build(&map, &WarpOptions::default())
-                    .map_err(|x| e(&x))?;
                 (Inner::Rtw { base, warps }, 1, single)
             }
             TechniqueKind::SpotFit => {

@@ -475,6 +475,44 @@ impl ImportanceMap {
         pixels_per_radian: f32,
         samples: &[EyeSample],
     ) -> Result<AccumulateStats, RtwError> {
+        self.accumulate_oracle_axis(
+            OracleAxis::Isotropic,
+            base,
+            camera,
+            pixels_per_radian,
+            samples,
+        )
+    }
+
+    /// Oracle importance for one texture axis of a separable warp.
+    ///
+    /// With `J` as in [`accumulate_oracle`](Self::accumulate_oracle), the columns of
+    /// `J⁻¹` are the screen-space extents (in pixels) of one unit of base `u` and of
+    /// base `v`. A separable warp scales each axis on its own, so each axis needs its
+    /// own density:
+    ///
+    /// ```text
+    /// OracleAxis::U:         |J⁻¹ e_u|   (pixels per unit u)
+    /// OracleAxis::V:         |J⁻¹ e_v|   (pixels per unit v)
+    /// OracleAxis::Isotropic: 1 / s_min(J) = ‖J⁻¹‖ ≥ both
+    /// ```
+    ///
+    /// Densities `rho_u ≥ |J⁻¹ e_u| / N`, `rho_v ≥ |J⁻¹ e_v| / N` make both texel edges at
+    /// most one pixel long (aliasing error `m ≤ √2`). The isotropic value asks for the
+    /// larger requirement on both axes, which wastes texels on the axis that does not
+    /// need them (a far ground plane needs density along the view, not across it).
+    /// Feed a `U` map and a `V` map to [`WarpMaps::build_separable`](crate::WarpMaps::build_separable).
+    ///
+    /// # Errors
+    /// As [`accumulate_oracle`](Self::accumulate_oracle).
+    pub fn accumulate_oracle_axis(
+        &mut self,
+        axis: OracleAxis,
+        base: &ShadowTransform,
+        camera: &Camera,
+        pixels_per_radian: f32,
+        samples: &[EyeSample],
+    ) -> Result<AccumulateStats, RtwError> {
         if !(pixels_per_radian.is_finite() && pixels_per_radian > 0.0) {
             return Err(RtwError::InvalidOption);
         }
@@ -519,9 +557,14 @@ impl ImportanceMap {
                 let (dx, dy) = (on_plane(right * (z / f_px)), on_plane(up * (z / f_px)));
                 let (ju, jv) = base.jacobian(h);
                 let (a, b, c, d) = (ju.dot(dx), ju.dot(dy), jv.dot(dx), jv.dot(dy));
-                let s_min = singular_min(a, b, c, d)?;
-                let q = 1.0 / s_min;
-                q.is_finite().then_some((uv, q))
+                let q = match axis {
+                    OracleAxis::Isotropic => 1.0 / singular_min(a, b, c, d)?,
+                    // J⁻¹ = [[d, -b], [-c, a]] / det: its columns are the pixel
+                    // extents of a unit step in u and in v.
+                    OracleAxis::U => math::sqrt(d * d + c * c) / (a * d - b * c).abs(),
+                    OracleAxis::V => math::sqrt(b * b + a * a) / (a * d - b * c).abs(),
+                };
+                (q.is_finite() && q > 0.0).then_some((uv, q))
             })();
             match value {
                 Some((uv, q)) if self.splat_f64(uv, q) => stats.accepted += 1,
@@ -530,6 +573,17 @@ impl ImportanceMap {
         }
         Ok(stats)
     }
+}
+
+/// Which requirement [`ImportanceMap::accumulate_oracle_axis`] records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OracleAxis {
+    /// The same density on both axes: `1 / s_min(J)`.
+    Isotropic,
+    /// The density the `u` axis needs.
+    U,
+    /// The density the `v` axis needs.
+    V,
 }
 
 /// Smaller singular value of `[[a, b], [c, d]]`, `None` if not positive.

@@ -220,6 +220,49 @@ impl WarpMaps {
             return Err(RtwError::ShapeMismatch);
         }
         collapse(map.as_slice(), &mut self.col_max, &mut self.row_max);
+        self.build_from_collapsed(options);
+        Ok(())
+    }
+
+    /// [`build`](Self::build) with separate importance per axis: the `u` warp from the
+    /// column maxima of `map_u`, the `v` warp from the row maxima of `map_v` (for
+    /// example the two maps of [`ImportanceMap::accumulate_oracle_axis`]).
+    ///
+    /// # Errors
+    /// As [`build`](Self::build), for either map.
+    pub fn build_separable(
+        &mut self,
+        map_u: &ImportanceMap,
+        map_v: &ImportanceMap,
+        options: &WarpOptions,
+    ) -> Result<(), RtwError> {
+        options.validate()?;
+        for map in [map_u, map_v] {
+            if map.width() as usize != self.x.len() || map.height() as usize != self.y.len() {
+                return Err(RtwError::ShapeMismatch);
+            }
+        }
+        // Only the column maxima of the u map and the row maxima of the v map feed a
+        // warp; the other halves of the two collapses are not computed.
+        let w = self.col_max.len();
+        self.col_max.fill(0.0);
+        for row in map_u.as_slice().chunks_exact(w) {
+            for (c, &x) in self.col_max.iter_mut().zip(row) {
+                *c = mx(*c, x);
+            }
+        }
+        for (r, row) in self
+            .row_max
+            .iter_mut()
+            .zip(map_v.as_slice().chunks_exact(w))
+        {
+            *r = row.iter().copied().fold(0.0, mx);
+        }
+        self.build_from_collapsed(options);
+        Ok(())
+    }
+
+    fn build_from_collapsed(&mut self, options: &WarpOptions) {
         let weights = gaussian_weights(options.blur_radius);
         let history = self.has_history;
         self.fallback[0] = axis(
@@ -241,7 +284,6 @@ impl WarpMaps {
             &mut self.y,
         );
         self.has_history = true;
-        Ok(())
     }
 }
 

@@ -1,0 +1,185 @@
+//! A thin wgpu backend for the shadowmap math crates: the shadow depth passes of
+//! every technique, the WGSL lookups and filters, the GPU parts of SDSM and RTW
+//! (compute), and a headless renderer for tests, reports and examples.
+//!
+//! The math crates compute everything per frame on the CPU (`shadowmap-frustum`,
+//! `shadowmap-warp`, `shadowmap-paraboloid`, `shadowmap-rtw`); this crate packs
+//! their results into uniform blocks ([`uniforms::ToRaw`]), evaluates per vertex or
+//! per pixel only what must be evaluated there, and checks itself against the CPU
+//! reference rasterizer of `shadowmap-eval`.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`context`] | [`GpuContext`]: headless device, error scopes ([`GpuContext::scoped`]), test gating |
+//! | [`uniforms`] | `#[repr(C)]` blocks built by [`uniforms::ToRaw`] |
+//! | [`depth`] | [`depth::ShadowDepthPass`]: matrix / paraboloid / RTW depth passes, caster subdivision for RTW |
+//! | [`render`] | [`render::HeadlessRenderer`]: scene pass with a lookup and a filter composed in, PNGs, shadow masks |
+//! | [`reduce`] | depth min/max reduction (SDSM, IPSM depth bounds) |
+//! | [`rtw`] | [`rtw::GpuRtw`]: importance, blur, warp tables on the GPU |
+//! | [`shaders`] | every WGSL source, embedded |
+//!
+//! # Example
+//!
+//! A uniform shadow map of one triangle, rendered and read back:
+//!
+//! ```no_run
+//! use glam::Vec3;
+//! use shadowmap_frustum::{Aabb, Camera, Projection};
+//! use shadowmap_warp::{FocusScene, UniformOptions, uniform_focused};
+//! use shadowmap_wgpu::depth::{DepthPassDesc, DepthTechnique, DepthUniforms, MeshBuffers, ShadowDepthPass};
+//! use shadowmap_wgpu::{GpuContext, uniforms::ToRaw};
+//!
+//! let ctx = GpuContext::new_headless()?;
+//! let camera = Camera::look_at(Vec3::new(0.0, 5.0, 15.0), Vec3::ZERO, Vec3::Y,
+//!     Projection::perspective(1.0, 1.0, 0.5, 50.0)).unwrap();
+//! let scene = FocusScene::whole(Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0)));
+//! let light = uniform_focused(&camera, Vec3::new(0.3, -1.0, 0.2), &scene, &UniformOptions::default()).unwrap();
+//!
+//! let caster = MeshBuffers::from_triangles(&ctx, &[[Vec3::ZERO, Vec3::X, Vec3::Y]])?;
+//! let mut pass = ShadowDepthPass::new(&ctx, &DepthPassDesc::new(DepthTechnique::Matrix, 1024))?;
+//! let depth = ctx.scoped(|ctx| {
+//!     let mut encoder = ctx.device.create_command_encoder(&Default::default());
+//!     pass.encode(ctx, &mut encoder, &[&caster], &DepthUniforms::Matrix(&[light.to_raw()]))?;
+//!     ctx.queue.submit([encoder.finish()]);
+//!     pass.readback_depth(ctx)
+//! })?;
+//! assert_eq!(depth.len(), 1024 * 1024);
+//! # Ok::<(), shadowmap_wgpu::BackendError>(())
+//! ```
+//!
+//! `examples/render_scene.rs` renders the city block with every technique into
+//! `target/shadowmap-report/rendered/*.png`.
+//!
+//! # Conventions
+//!
+//! - **Spaces.** WebGPU clip space (`x, y` in `[-w, w]`, `z` in `[0, w]`), texture
+//!   `uv` with `v` down (row 0 at the top), matrices named destination-from-source
+//!   and uploaded column-major (`clip_from_world`), as in `shadowmap-frustum`.
+//! - **Uniform layouts.** Every block is a whole number of 16-byte rows
+//!   (`mat4x4<f32>` columns, `vec4` rows; scalars packed into `vec4`s), so
+//!   `#[repr(C)]` and WGSL's uniform layout agree with no hidden padding;
+//!   `tests/uniforms.rs` checks sizes and offsets against naga's layouter. The depth
+//!   pass writes its map resolution into one spare lane (`ParaboloidLayerRaw::side.y`,
+//!   `RtwShadowRaw::sizes.w`) for the subpixel snap below.
+//! - **Bind groups.** Depth passes: group 0 = binding 0 the layer's block (one
+//!   256-byte-aligned slot per layer, dynamic offset), binding 1 the RTW tables.
+//!   Scene pass: group 0 the frame (`FrameRaw`), group 1 the lookup (binding 0 the
+//!   technique's block, binding 1 the RTW tables), group 2 the maps (binding 0 the
+//!   `texture_depth_2d_array`, 1 the comparison sampler, 2 the VSM moments). Compute
+//!   passes own group 0 (see [`reduce`] and [`rtw`]).
+//! - **Depth maps.** `Depth32Float` 2-D arrays, one layer per cascade or paraboloid
+//!   side. Standard depth clears to 1 and keeps `Less`; **reversed-Z** (the
+//!   transform's `reversed_z`) clears to 0 and keeps `Greater`, the lookups flip
+//!   their comparisons, and biases change sign.
+//! - **Bias.** Two parts ([`render::ShadowBias`]): the depth pass's rasterizer bias
+//!   ([`depth::DepthBias`], wgpu's `DepthBiasState`: `slope_scale * max(|dz/dx|,
+//!   |dz/dy|) + constant * 2^(e - 23)`, clamped), positive away from the light for
+//!   standard depth and negated for reversed-Z; and a lookup bias in stored-depth
+//!   units toward the light (plus XPSM's world-units Z bias). The renderer's
+//!   per-technique defaults ([`render::ShadowBias::default_for`]) scale the slope
+//!   term with the filter's reach.
+//! - **RTW tables.** One storage buffer of `f32`: the `u` table (`sizes.x` texels)
+//!   then the `v` table (`sizes.y` texels), texel `i` holding the offset at
+//!   `(i + 0.5) / N`, `T[0] = T[N-1] = 0`, sampled by hand with the texel-centre
+//!   linear, clamp-to-edge semantics of `shadowmap_rtw::forward_warp`. Written by
+//!   the CPU ([`uniforms::RtwShadowRaw::tables`]) or by [`rtw::GpuRtw`] (fed to the
+//!   depth pass by [`rtw::GpuRtw::depth_uniforms`]). Casters are subdivided on the
+//!   CPU ([`depth::subdivide_for_rtw`]) since only vertices are warped.
+//! - **Subpixel snap.** The paraboloid and RTW vertex shaders snap positions to the
+//!   1/256-pixel grid of the rasterizer: their maps compress, so casters become
+//!   slivers with depth slopes near 1 per texel, and rasterizers differ in whether
+//!   the depth plane uses snapped positions (llvmpipe does not); snapping first
+//!   makes every rasterizer store the same depths.
+//! - **Errors.** Invalid input is [`BackendError::InvalidInput`]; GPU work that wgpu
+//!   rejects is caught in error scopes ([`GpuContext::scoped`]) and returned as
+//!   [`BackendError::Wgpu`], never a panic.
+//!
+//! # GPU tests
+//!
+//! The tests in `tests/gpu_*.rs` compare the GPU with the CPU references of
+//! `shadowmap-eval` and `shadowmap-rtw`. Each opens its device with
+//! [`context::test_context`]: without an adapter it prints a one-line notice and
+//! passes (skips); with `SHADOWMAP_REQUIRE_GPU=1` a missing adapter fails the test,
+//! so CI cannot skip silently. Mesa's llvmpipe (software Vulkan) is enough:
+//!
+//! ```text
+//! SHADOWMAP_REQUIRE_GPU=1 cargo test -p shadowmap-wgpu
+//! ```
+//!
+//! # GPU timings
+//!
+//! None were recorded: no hardware GPU was lent to this task. `cargo bench -p
+//! shadowmap-wgpu --bench frame` and `--bench compute` measure the CPU side (uniform
+//! packing, command encoding, caster subdivision) and, where an adapter opens, GPU
+//! round trips; on this machine the adapter is llvmpipe, so any GPU-side figure is
+//! a software-adapter figure (CPU rasterization), not a GPU timing. `--bench frame`
+//! on a shared 2-core machine, release profile, adapter llvmpipe (LLVM 15, 256
+//! bits); the `encode/*` rows are CPU time to record commands (the adapter only
+//! matters through wgpu's validation):
+//!
+//! ```text
+//! pack/uniform, pack/xpsm (to_raw)                 16 ns
+//! pack/cascades_lookup_4                           39 ns
+//! pack/cascades_layers_4                           60 ns
+//! pack/paraboloid_layers                           47 ns
+//! pack/rtw_256 (block + 512 table floats)          67 ns
+//! subdivide_rtw/city_block_256_cells_2048          64 ms  (5264 -> 722 512 triangles)
+//! encode/cascades_4_depth_passes                   25 us
+//! encode/rtw_depth_pass_256_cell_tables            23 us
+//! ```
+
+pub mod context;
+pub use context::{BackendError, GpuContext};
+
+// --- depth passes, uniforms, lookup, headless renderer (one author) ---
+pub mod depth;
+pub mod render;
+pub mod uniforms;
+
+// --- compute passes: depth reduction, RTW pipeline (another author) ---
+pub mod reduce;
+pub mod rtw;
+
+/// The WGSL sources in `shaders/`, embedded so users need no file access.
+pub mod shaders {
+    // Each author adds `pub const NAME: &str = include_str!("../../../shaders/<file>.wgsl");`
+    // for the files they own, with a one-line doc comment.
+
+    // --- depth passes, lookups, filters, renderer (depth_*, lookup_*, filter_*, render_*) ---
+    /// Depth pass of the matrix techniques (uniform, cascades, LiSPSM, XPSM, TSM).
+    pub const DEPTH_MATRIX: &str = include_str!("../../../shaders/depth_matrix.wgsl");
+    /// Depth pass of a paraboloid map (one side per layer, hemisphere clipped).
+    pub const DEPTH_PARABOLOID: &str = include_str!("../../../shaders/depth_paraboloid.wgsl");
+    /// Depth pass of RTW (base projection, then the warp tables per axis).
+    pub const DEPTH_RTW: &str = include_str!("../../../shaders/depth_rtw.wgsl");
+    /// Lookup of a matrix technique (uniform, LiSPSM, XPSM with its Z bias, TSM).
+    pub const LOOKUP_MATRIX: &str = include_str!("../../../shaders/lookup_matrix.wgsl");
+    /// Lookup of cascades: selection by view depth with the blend band, or by projection.
+    pub const LOOKUP_CASCADES: &str = include_str!("../../../shaders/lookup_cascades.wgsl");
+    /// Lookup of a paraboloid map (front/back side, cut).
+    pub const LOOKUP_PARABOLOID: &str = include_str!("../../../shaders/lookup_paraboloid.wgsl");
+    /// Lookup of RTW (base projection, warp tables).
+    pub const LOOKUP_RTW: &str = include_str!("../../../shaders/lookup_rtw.wgsl");
+    /// Filter: one nearest texel.
+    pub const FILTER_HARD: &str = include_str!("../../../shaders/filter_hard.wgsl");
+    /// Filter: the hardware 2x2 compare.
+    pub const FILTER_HARDWARE: &str = include_str!("../../../shaders/filter_hardware.wgsl");
+    /// Filter: N x N percentage-closer filtering.
+    pub const FILTER_PCF: &str = include_str!("../../../shaders/filter_pcf.wgsl");
+    /// Filter: Poisson-disk percentage-closer filtering.
+    pub const FILTER_POISSON: &str = include_str!("../../../shaders/filter_poisson.wgsl");
+    /// Filter: variance shadow maps (Chebyshev bound on blurred moments).
+    pub const FILTER_VSM: &str = include_str!("../../../shaders/filter_vsm.wgsl");
+    /// VSM moments pass and separable blur (full-screen fragment passes).
+    pub const FILTER_VSM_MOMENTS: &str = include_str!("../../../shaders/filter_vsm_moments.wgsl");
+    /// The headless renderer's scene pass (a lookup and a filter are composed in).
+    pub const RENDER_SCENE: &str = include_str!("../../../shaders/render_scene.wgsl");
+
+    // --- compute (reduce_*, rtw_*) ---
+    /// Min/max reduction of a depth buffer (two entry points: tiles, then partials).
+    pub const REDUCE_DEPTH: &str = include_str!("../../../shaders/reduce_depth.wgsl");
+    /// RTW importance splat from an eye-space G-buffer and collapse to 1-D maxima.
+    pub const RTW_IMPORTANCE: &str = include_str!("../../../shaders/rtw_importance.wgsl");
+    /// RTW per-axis blur, normalization, temporal smoothing, floor and warp table.
+    pub const RTW_WARP: &str = include_str!("../../../shaders/rtw_warp.wgsl");
+}

@@ -1,0 +1,333 @@
+//! Uniform blocks (`#[repr(C)]`, [`bytemuck::Pod`]) built from the math crates'
+//! outputs by [`ToRaw::to_raw`].
+//!
+//! No math is repeated here: every field is copied from what a builder of
+//! `shadowmap-frustum`, `shadowmap-warp`, `shadowmap-paraboloid` or `shadowmap-rtw`
+//! computed; the WGSL evaluates only what must be evaluated per vertex or per pixel.
+//!
+//! Layout: every block is a whole number of 16-byte rows (`mat4x4<f32>` columns and
+//! `vec4` rows), so `#[repr(C)]` and WGSL's uniform layout agree without hidden
+//! padding; `tests/uniforms.rs` checks each size and offset against naga's layouter
+//! and the WGSL struct of the same name.
+//!
+//! ```
+//! use glam::{Mat4, Vec3};
+//! use shadowmap_frustum::{LightDirection, ShadowTransform};
+//! use shadowmap_wgpu::uniforms::ToRaw;
+//!
+//! let t = ShadowTransform::new(Mat4::IDENTITY, Mat4::IDENTITY, false, LightDirection::Directional(Vec3::NEG_Y));
+//! let raw = t.to_raw();
+//! assert_eq!(raw.uv_from_world, t.uv_from_world.to_cols_array_2d());
+//! assert_eq!(bytemuck::bytes_of(&raw).len(), 144);
+//! ```
+
+use bytemuck::{Pod, Zeroable};
+use glam::Mat4;
+use shadowmap_frustum::{CascadeSet, LightDirection, MAX_CASCADES, ShadowTransform};
+use shadowmap_paraboloid::{ParaboloidMap, Side};
+use shadowmap_rtw::RtwShadow;
+use shadowmap_warp::{LispsmShadow, TsmShadow, XpsmShadow};
+
+/// Converts a math-crate result into the uniform block its shaders read.
+pub trait ToRaw {
+    /// The `#[repr(C)]` block.
+    type Raw: Pod;
+    /// The block.
+    fn to_raw(&self) -> Self::Raw;
+}
+
+fn cols(m: &Mat4) -> [[f32; 4]; 4] {
+    m.to_cols_array_2d()
+}
+
+fn flag(b: bool) -> f32 {
+    f32::from(u8::from(b))
+}
+
+/// A matrix technique (uniform, one cascade, LiSPSM, XPSM, TSM): WGSL `MatrixShadow`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct MatrixShadowRaw {
+    /// Depth pass, WebGPU clip space.
+    pub clip_from_world: [[f32; 4]; 4],
+    /// Lookup, texture space (divide by `w`).
+    pub uv_from_world: [[f32; 4]; 4],
+    /// `x`: reversed-Z (0 or 1); `y`: XPSM's `z_bias_scale = 1 / (MaxZ - MinZ)` (0 for
+    /// the other techniques: their bias is applied in depth units after the
+    /// division); `z`, `w`: 0.
+    pub params: [f32; 4],
+}
+
+impl ToRaw for ShadowTransform {
+    type Raw = MatrixShadowRaw;
+    fn to_raw(&self) -> MatrixShadowRaw {
+        MatrixShadowRaw {
+            clip_from_world: cols(&self.clip_from_world),
+            uv_from_world: cols(&self.uv_from_world),
+            params: [flag(self.reversed_z), 0.0, 0.0, 0.0],
+        }
+    }
+}
+
+impl ToRaw for LispsmShadow {
+    type Raw = MatrixShadowRaw;
+    fn to_raw(&self) -> MatrixShadowRaw {
+        self.transform.to_raw()
+    }
+}
+
+impl ToRaw for TsmShadow {
+    type Raw = MatrixShadowRaw;
+    fn to_raw(&self) -> MatrixShadowRaw {
+        self.transform.to_raw()
+    }
+}
+
+impl ToRaw for XpsmShadow {
+    type Raw = MatrixShadowRaw;
+    /// With the step-18 Z bias scale in `params.y`: the lookup moves clip `z` by
+    /// `-bias * z_bias_scale` (`+` reversed) before dividing by `w`, as
+    /// [`XpsmShadow::biased_clip_z`] does.
+    fn to_raw(&self) -> MatrixShadowRaw {
+        let mut raw = self.transform.to_raw();
+        raw.params[1] = self.z_bias_scale;
+        raw
+    }
+}
+
+/// Cascaded shadow maps for the lookup: WGSL `CascadeShadow`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct CascadeShadowRaw {
+    /// One lookup matrix per cascade (unused entries zero).
+    pub uv_from_world: [[[f32; 4]; 4]; MAX_CASCADES],
+    /// Row 2 of the camera's `view_from_world`: view depth is `-dot(row, (P, 1))`.
+    pub view_z_row: [f32; 4],
+    /// Far split depth of cascade `i` (`CascadeSplits::depths()[i + 1]`), 4 per row.
+    pub split_far: [[f32; 4]; 2],
+    /// Blend band at the far end of cascade `i` (`CascadeSplits::band_width(i)`).
+    pub band_width: [[f32; 4]; 2],
+    /// Number of cascades.
+    pub count: u32,
+    /// Reversed-Z (0 or 1).
+    pub reversed_z: u32,
+    /// Cascade selection: 0 by view depth (with the blend band), 1 by projection.
+    pub select_by_projection: u32,
+    /// Margin for selection by projection, in texture coordinates (the margin in
+    /// texels of `CascadeSet::select_by_projection` over the resolution).
+    pub margin_uv: f32,
+}
+
+impl CascadeShadowRaw {
+    /// Selection by projection (the finest map containing the point) instead of by
+    /// view depth, with a margin of `margin_texels` texels of a `resolution²` map,
+    /// as `CascadeSet::select_by_projection`. A non-finite or negative margin, or a
+    /// zero resolution, gives no margin.
+    #[must_use]
+    pub fn with_selection_by_projection(mut self, margin_texels: f32, resolution: u32) -> Self {
+        self.select_by_projection = 1;
+        let m = f64::from(margin_texels) / f64::from(resolution.max(1));
+        self.margin_uv = if m.is_finite() && resolution > 0 {
+            m.max(0.0) as f32
+        } else {
+            0.0
+        };
+        self
+    }
+}
+
+impl ToRaw for CascadeSet {
+    type Raw = CascadeShadowRaw;
+    fn to_raw(&self) -> CascadeShadowRaw {
+        let mut raw = CascadeShadowRaw::zeroed();
+        let depths = self.splits.depths();
+        for (i, c) in self.cascades.iter().enumerate().take(MAX_CASCADES) {
+            raw.uv_from_world[i] = cols(&c.transform.uv_from_world);
+            raw.split_far[i / 4][i % 4] = depths.get(i + 1).copied().unwrap_or(f32::MAX);
+            raw.band_width[i / 4][i % 4] = self.splits.band_width(i);
+        }
+        let row = self.view_from_world.row(2);
+        raw.view_z_row = row.to_array();
+        raw.count = self.cascades.len() as u32;
+        raw.reversed_z = u32::from(
+            self.cascades
+                .first()
+                .is_some_and(|c| c.transform.reversed_z),
+        );
+        raw
+    }
+}
+
+/// The per-layer depth-pass blocks of a cascade set: one [`MatrixShadowRaw`] per
+/// cascade (layer `i` = cascade `i`).
+#[must_use]
+pub fn cascade_layers(set: &CascadeSet) -> Vec<MatrixShadowRaw> {
+    set.cascades.iter().map(|c| c.transform.to_raw()).collect()
+}
+
+/// A paraboloid map: WGSL `Paraboloid`, the fields of
+/// [`shadowmap_paraboloid::ParaboloidUniform`] (made `Pod`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct ParaboloidRaw {
+    /// `light_from_world` with its translation cleared, column-major.
+    pub rotation: [[f32; 4]; 4],
+    /// Light position (xyz) and near distance (w).
+    pub position_near: [f32; 4],
+    /// Far distance, zoom, reversed-Z (0 or 1), dual (0 or 1).
+    pub far_zoom_reversed_dual: [f32; 4],
+}
+
+impl ToRaw for ParaboloidMap {
+    type Raw = ParaboloidRaw;
+    fn to_raw(&self) -> ParaboloidRaw {
+        let u = ParaboloidMap::to_raw(self);
+        ParaboloidRaw {
+            rotation: u.rotation,
+            position_near: u.position_near,
+            far_zoom_reversed_dual: u.far_zoom_reversed_dual,
+        }
+    }
+}
+
+/// One layer of the paraboloid depth pass: WGSL `ParaboloidLayer`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct ParaboloidLayerRaw {
+    /// The map.
+    pub map: ParaboloidRaw,
+    /// `x`: the side rendered, 0 front, 1 back; `y`: 0 from
+    /// [`ParaboloidLayerRaw::new`], the depth pass writes its map resolution there
+    /// (the vertex shader snaps to its subpixel grid); `z`, `w`: 0.
+    pub side: [f32; 4],
+}
+
+impl ParaboloidLayerRaw {
+    /// The block for one side of a map.
+    #[must_use]
+    pub fn new(map: &ParaboloidMap, side: Side) -> Self {
+        Self {
+            map: ToRaw::to_raw(map),
+            side: [side.layer() as f32, 0.0, 0.0, 0.0],
+        }
+    }
+}
+
+/// The depth-pass blocks of a paraboloid map, one per layer (front, then back for a
+/// dual map).
+#[must_use]
+pub fn paraboloid_layers(map: &ParaboloidMap) -> Vec<ParaboloidLayerRaw> {
+    let mut v = vec![ParaboloidLayerRaw::new(map, Side::Front)];
+    if map.layers() > 1 {
+        v.push(ParaboloidLayerRaw::new(map, Side::Back));
+    }
+    v
+}
+
+/// Rectilinear texture warping: WGSL `RtwShadow`. The tables themselves travel in a
+/// storage buffer (`x` table, then `y` table, `f32`), see
+/// [`RtwShadowRaw::tables`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct RtwShadowRaw {
+    /// Base projection, WebGPU clip space.
+    pub clip_from_world: [[f32; 4]; 4],
+    /// Base projection, texture space.
+    pub uv_from_world: [[f32; 4]; 4],
+    /// `x`: texels of the `u` table; `y`: texels of the `v` table; `z`: reversed-Z
+    /// (0 or 1); `w`: 0 from [`ToRaw::to_raw`]. The depth pass writes its map
+    /// resolution into `w` (the vertex shader snaps to its subpixel grid, see
+    /// `shaders/depth_rtw.wgsl`); the lookup ignores it.
+    pub sizes: [u32; 4],
+}
+
+impl ToRaw for RtwShadow<'_> {
+    type Raw = RtwShadowRaw;
+    fn to_raw(&self) -> RtwShadowRaw {
+        RtwShadowRaw::from_base(
+            &self.base,
+            self.warps.x_table().len() as u32,
+            self.warps.y_table().len() as u32,
+        )
+    }
+}
+
+impl RtwShadowRaw {
+    /// The block for a base projection and tables of `u_texels` and `v_texels`
+    /// texels held elsewhere (e.g. built on the GPU by
+    /// [`crate::rtw::GpuRtw`]).
+    #[must_use]
+    pub fn from_base(base: &ShadowTransform, u_texels: u32, v_texels: u32) -> Self {
+        Self {
+            clip_from_world: cols(&base.clip_from_world),
+            uv_from_world: cols(&base.uv_from_world),
+            sizes: [u_texels, v_texels, u32::from(base.reversed_z), 0],
+        }
+    }
+
+    /// The storage-buffer contents for the tables of `shadow`: the `u` table then the
+    /// `v` table. An empty table set becomes one zero (WebGPU rejects empty buffers;
+    /// an empty table reads as offset 0 anyway).
+    #[must_use]
+    pub fn tables(shadow: &RtwShadow<'_>) -> Vec<f32> {
+        let mut v = Vec::with_capacity(shadow.warps.x_table().len() + shadow.warps.y_table().len());
+        v.extend_from_slice(shadow.warps.x_table());
+        v.extend_from_slice(shadow.warps.y_table());
+        if v.is_empty() {
+            v.push(0.0);
+        }
+        v
+    }
+}
+
+/// Per-frame data of the headless renderer: WGSL `Frame`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct FrameRaw {
+    /// The camera's `clip_from_world`.
+    pub clip_from_world: [[f32; 4]; 4],
+    /// The camera's `view_from_world` (view depth `-z`).
+    pub view_from_world: [[f32; 4]; 4],
+    /// Directional light: the direction light travels, `w = 0`; point light: its
+    /// position, `w = 1`.
+    pub light: [f32; 4],
+    /// `x`: depth bias in stored-depth units (toward the light, sign flipped for
+    /// reversed-Z); `y`: world-units bias (XPSM's warped Z bias); `z`: filter radius
+    /// in texels; `w`: reversed-Z of the shadow map (0 or 1).
+    pub bias: [f32; 4],
+    /// `x`, `y`, `z`: shadow map width, height, layers; `w`: filter taps per side
+    /// (PCF).
+    pub shadow_size: [f32; 4],
+    /// Camera position (`xyz`), `w = 1`.
+    pub eye: [f32; 4],
+}
+
+impl FrameRaw {
+    /// The light vector of a [`LightDirection`].
+    #[must_use]
+    pub fn light_vector(light: LightDirection) -> [f32; 4] {
+        match light {
+            LightDirection::Directional(d) => d.extend(0.0).to_array(),
+            LightDirection::Position(p) => p.extend(1.0).to_array(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn xpsm_bias_scale_lands_in_params() {
+        let t = ShadowTransform::new(
+            Mat4::IDENTITY,
+            Mat4::from_scale(Vec3::splat(2.0)),
+            true,
+            LightDirection::Directional(Vec3::NEG_Y),
+        );
+        let raw = t.to_raw();
+        assert_eq!(raw.params, [1.0, 0.0, 0.0, 0.0]);
+        assert_eq!(raw.clip_from_world[0][0], 2.0);
+    }
+}

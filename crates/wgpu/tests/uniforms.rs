@@ -1,0 +1,221 @@
+//! Every `#[repr(C)]` uniform block has the size and member offsets naga computes for
+//! the WGSL struct of the same role, so no vec3 padding or array stride differs.
+
+use core::mem::{offset_of, size_of};
+
+use glam::{Mat4, Vec3};
+use shadowmap_frustum::{
+    Camera, CascadeOptions, CascadeSet, CascadeSplits, LightDirection, Projection, ShadowTransform,
+    SplitScheme,
+};
+use shadowmap_paraboloid::{MapOptions, ParaboloidMap};
+use shadowmap_wgpu::shaders;
+use shadowmap_wgpu::uniforms::{
+    CascadeShadowRaw, FrameRaw, MatrixShadowRaw, ParaboloidLayerRaw, ParaboloidRaw, RtwShadowRaw,
+    ToRaw, cascade_layers, paraboloid_layers,
+};
+
+/// (struct span, member offsets) of `name` in `source`, by naga's layouter.
+fn wgsl_layout(source: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+    let module = naga::front::wgsl::parse_str(source).expect("parses");
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).expect("layout");
+    for (_, ty) in module.types.iter() {
+        if ty.name.as_deref() == Some(name) {
+            if let naga::TypeInner::Struct { members, span } = &ty.inner {
+                let offsets = members
+                    .iter()
+                    .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                    .collect();
+                return (*span, offsets);
+            }
+        }
+    }
+    panic!("struct {name} not found");
+}
+
+fn check(source: &str, name: &str, size: usize, offsets: &[(&str, usize)]) {
+    let (span, members) = wgsl_layout(source, name);
+    assert_eq!(span as usize, size, "{name}: size");
+    assert_eq!(members.len(), offsets.len(), "{name}: member count");
+    for ((wgsl_name, wgsl_offset), (rust_name, rust_offset)) in members.iter().zip(offsets) {
+        assert_eq!(wgsl_name, rust_name, "{name}: member order");
+        assert_eq!(
+            *wgsl_offset as usize, *rust_offset,
+            "{name}.{rust_name}: offset"
+        );
+    }
+}
+
+#[test]
+fn matrix_block_matches_every_shader_that_reads_it() {
+    let offsets = [
+        (
+            "clip_from_world",
+            offset_of!(MatrixShadowRaw, clip_from_world),
+        ),
+        ("uv_from_world", offset_of!(MatrixShadowRaw, uv_from_world)),
+        ("params", offset_of!(MatrixShadowRaw, params)),
+    ];
+    for source in [shaders::DEPTH_MATRIX, shaders::LOOKUP_MATRIX] {
+        check(
+            source,
+            "MatrixShadow",
+            size_of::<MatrixShadowRaw>(),
+            &offsets,
+        );
+    }
+}
+
+#[test]
+fn cascade_block_matches() {
+    check(
+        shaders::LOOKUP_CASCADES,
+        "CascadeShadow",
+        size_of::<CascadeShadowRaw>(),
+        &[
+            ("uv_from_world", offset_of!(CascadeShadowRaw, uv_from_world)),
+            ("view_z_row", offset_of!(CascadeShadowRaw, view_z_row)),
+            ("split_far", offset_of!(CascadeShadowRaw, split_far)),
+            ("band_width", offset_of!(CascadeShadowRaw, band_width)),
+            ("count", offset_of!(CascadeShadowRaw, count)),
+            ("reversed_z", offset_of!(CascadeShadowRaw, reversed_z)),
+            (
+                "select_by_projection",
+                offset_of!(CascadeShadowRaw, select_by_projection),
+            ),
+            ("margin_uv", offset_of!(CascadeShadowRaw, margin_uv)),
+        ],
+    );
+}
+
+#[test]
+fn paraboloid_blocks_match() {
+    let map_offsets = [
+        ("rotation", offset_of!(ParaboloidRaw, rotation)),
+        ("position_near", offset_of!(ParaboloidRaw, position_near)),
+        (
+            "far_zoom_reversed_dual",
+            offset_of!(ParaboloidRaw, far_zoom_reversed_dual),
+        ),
+    ];
+    for source in [shaders::DEPTH_PARABOLOID, shaders::LOOKUP_PARABOLOID] {
+        check(
+            source,
+            "Paraboloid",
+            size_of::<ParaboloidRaw>(),
+            &map_offsets,
+        );
+    }
+    check(
+        shaders::DEPTH_PARABOLOID,
+        "ParaboloidLayer",
+        size_of::<ParaboloidLayerRaw>(),
+        &[
+            ("map", offset_of!(ParaboloidLayerRaw, map)),
+            ("side", offset_of!(ParaboloidLayerRaw, side)),
+        ],
+    );
+}
+
+#[test]
+fn rtw_and_frame_blocks_match() {
+    let rtw = [
+        ("clip_from_world", offset_of!(RtwShadowRaw, clip_from_world)),
+        ("uv_from_world", offset_of!(RtwShadowRaw, uv_from_world)),
+        ("sizes", offset_of!(RtwShadowRaw, sizes)),
+    ];
+    for source in [shaders::DEPTH_RTW, shaders::LOOKUP_RTW] {
+        check(source, "RtwShadow", size_of::<RtwShadowRaw>(), &rtw);
+    }
+    check(
+        shaders::RENDER_SCENE,
+        "Frame",
+        size_of::<FrameRaw>(),
+        &[
+            ("clip_from_world", offset_of!(FrameRaw, clip_from_world)),
+            ("view_from_world", offset_of!(FrameRaw, view_from_world)),
+            ("light", offset_of!(FrameRaw, light)),
+            ("bias", offset_of!(FrameRaw, bias)),
+            ("shadow_size", offset_of!(FrameRaw, shadow_size)),
+            ("eye", offset_of!(FrameRaw, eye)),
+        ],
+    );
+}
+
+#[test]
+fn to_raw_copies_the_math_crates_outputs() {
+    let camera = Camera::look_to(
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::NEG_Z,
+        Vec3::Y,
+        Projection::perspective(1.0, 1.5, 0.1, 100.0),
+    )
+    .unwrap();
+    let splits = CascadeSplits::new(&SplitScheme::Logarithmic, 3, 0.1, 100.0)
+        .unwrap()
+        .with_overlap(0.2)
+        .unwrap();
+    let set = CascadeSet::fit(
+        &camera,
+        Vec3::new(0.3, -1.0, 0.2),
+        &splits,
+        &CascadeOptions::default().with_reversed_z(true),
+    )
+    .unwrap();
+    let raw = set.to_raw();
+    assert_eq!(raw.count, 3);
+    assert_eq!(raw.reversed_z, 1);
+    for i in 0..3 {
+        assert_eq!(
+            raw.uv_from_world[i],
+            set.cascades[i].transform.uv_from_world.to_cols_array_2d()
+        );
+        assert_eq!(raw.split_far[0][i], splits.depths()[i + 1]);
+        assert_eq!(raw.band_width[0][i], splits.band_width(i));
+    }
+    assert_eq!(
+        raw.uv_from_world[3], [[0.0; 4]; 4],
+        "unused cascades are zero"
+    );
+    // View depth of a point through the packed row equals the camera's.
+    let p = Vec3::new(1.0, 0.5, -20.0);
+    let row = glam::Vec4::from_array(raw.view_z_row);
+    assert!((-row.dot(p.extend(1.0)) - camera.view_depth(p)).abs() < 1e-4);
+    let by_projection = raw.with_selection_by_projection(2.0, set.resolution);
+    assert_eq!(by_projection.select_by_projection, 1);
+    assert!((by_projection.margin_uv - 2.0 / set.resolution as f32).abs() < 1e-9);
+    assert_eq!(raw.with_selection_by_projection(f32::NAN, 0).margin_uv, 0.0);
+    assert_eq!(cascade_layers(&set).len(), 3);
+
+    let map = ParaboloidMap::dual(
+        Vec3::new(1.0, 2.0, 3.0),
+        Vec3::NEG_Y,
+        0.5,
+        50.0,
+        &MapOptions::default(),
+    )
+    .unwrap();
+    let p = ToRaw::to_raw(&map);
+    let reference = ParaboloidMap::to_raw(&map);
+    assert_eq!(p.rotation, reference.rotation);
+    assert_eq!(p.position_near, [1.0, 2.0, 3.0, 0.5]);
+    assert_eq!(p.far_zoom_reversed_dual, [50.0, 1.0, 0.0, 1.0]);
+    let layers = paraboloid_layers(&map);
+    assert_eq!(layers.len(), 2);
+    assert_eq!((layers[0].side[0], layers[1].side[0]), (0.0, 1.0));
+
+    let t = ShadowTransform::new(
+        Mat4::IDENTITY,
+        Mat4::from_translation(Vec3::X),
+        false,
+        LightDirection::Position(Vec3::new(4.0, 5.0, 6.0)),
+    );
+    let m = t.to_raw();
+    assert_eq!(m.clip_from_world[3], [1.0, 0.0, 0.0, 1.0]);
+    assert_eq!(m.params, [0.0; 4]);
+    assert_eq!(
+        FrameRaw::light_vector(LightDirection::Position(Vec3::new(4.0, 5.0, 6.0))),
+        [4.0, 5.0, 6.0, 1.0]
+    );
+}
