@@ -144,4 +144,4 @@ pub use importance::{
 pub use table::{
     forward_warp, forward_warp_f64, inverse_warp, inverse_warp_f64, sample_table, sample_table_f64,
 };
-pub use warp::{MAX_BLUR_RADIUS, MIN_FLOOR, RtwShadow, WarpMaps, WarpOptions};
+pub use warp::{MAX_BLUR_RADIUS, MIN_FLOOR, RtwShadow, WarpMaps, WarpOptions, gaussian_weights};

@@ -354,8 +354,16 @@ fn collapse_row(row: &[f32], col_max: &mut [f32]) -> f32 {
     m
 }
 
-/// Normalized Gaussian weights `w[0..=radius]` (symmetric kernel).
-fn gaussian_weights(radius: u32) -> ArrayVec<f64, { MAX_BLUR_RADIUS as usize + 1 }> {
+/// The blur of [`WarpMaps::build`]: normalized Gaussian weights `w[0..=radius]` of a
+/// symmetric kernel, so a GPU port can upload exactly the weights the CPU uses.
+///
+/// ```text
+/// w_k = exp(-k² / (2 sigma²)) / total,   sigma = radius / 2,   w_0 + 2 Σ_{k≥1} w_k = 1
+/// ```
+///
+/// `radius` is clamped to [`MAX_BLUR_RADIUS`]; radius 0 gives `[1]`.
+#[must_use]
+pub fn gaussian_weights(radius: u32) -> ArrayVec<f64, { MAX_BLUR_RADIUS as usize + 1 }> {
     let r = radius.min(MAX_BLUR_RADIUS) as usize;
     let mut w = ArrayVec::new();
     if r == 0 {

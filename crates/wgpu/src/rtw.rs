@@ -220,25 +220,10 @@ struct WarpParamsRaw {
     weights: [[f32; 4]; WEIGHT_VECTORS],
 }
 
-/// The normalized Gaussian weights of `shadowmap_rtw::WarpMaps::build`:
-/// `exp(-k² / (2 sigma²))`, `sigma = radius / 2`, `w_0 + 2 sum w_k = 1` (in `f64`).
+/// The Gaussian weights of `shadowmap_rtw::WarpMaps::build`, packed into `vec4`s.
 fn gaussian_weights(radius: u32) -> [[f32; 4]; WEIGHT_VECTORS] {
-    let r = radius.min(MAX_BLUR_RADIUS) as usize;
-    let mut w = [0.0f64; MAX_BLUR_RADIUS as usize + 1];
-    w[0] = 1.0;
-    if r > 0 {
-        let sigma = r as f64 / 2.0;
-        for (k, wk) in w.iter_mut().enumerate().take(r + 1) {
-            let k = k as f64;
-            *wk = (-k * k / (2.0 * sigma * sigma)).exp();
-        }
-        let total: f64 = w[0] + 2.0 * w[1..=r].iter().sum::<f64>();
-        for wk in &mut w[..=r] {
-            *wk /= total;
-        }
-    }
     let mut packed = [[0.0f32; 4]; WEIGHT_VECTORS];
-    for (k, &wk) in w.iter().enumerate() {
+    for (k, &wk) in shadowmap_rtw::gaussian_weights(radius).iter().enumerate() {
         packed[k / 4][k % 4] = wk as f32;
     }
     packed
