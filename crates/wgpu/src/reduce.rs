@@ -16,22 +16,24 @@
 //! min/max, which is exact: the GPU result equals the CPU min/max of the same values.
 //!
 //! # Example
-//! ```no_run
-//! use shadowmap_wgpu::GpuContext;
+//! ```
+//! use shadowmap_frustum::{Camera, DepthBounds};
 //! use shadowmap_wgpu::reduce::DepthReduction;
-//! # fn depth_texture(ctx: &GpuContext) -> wgpu::Texture { unimplemented!() }
-//! # fn camera() -> shadowmap_frustum::Camera { unimplemented!() }
-//! let ctx = GpuContext::new_headless()?;
-//! let depth: wgpu::Texture = depth_texture(&ctx); // the eye's depth buffer, already rendered
-//! let mut reduction = DepthReduction::new(&ctx, false);
-//! let mut encoder = ctx.device.create_command_encoder(&Default::default());
-//! reduction.encode(&ctx, &mut encoder, &depth)?;
-//! ctx.queue.submit([encoder.finish()]);
-//! if let Some(raw) = reduction.read(&ctx)? {
-//!     let bounds = raw.view_depth_bounds(&camera()).expect("valid camera");
-//!     println!("visible view depth in [{}, {}]", bounds.min, bounds.max);
+//! use shadowmap_wgpu::{BackendError, GpuContext};
+//!
+//! /// Visible view-depth bounds of the eye's depth buffer (already rendered).
+//! fn visible_depth(
+//!     ctx: &GpuContext,
+//!     depth: &wgpu::Texture,
+//!     camera: &Camera,
+//! ) -> Result<Option<DepthBounds>, BackendError> {
+//!     let mut reduction = DepthReduction::new(ctx, camera.reversed_z);
+//!     let mut encoder = ctx.device.create_command_encoder(&Default::default());
+//!     reduction.encode(ctx, &mut encoder, depth)?;
+//!     ctx.queue.submit([encoder.finish()]);
+//!     // `None`: every texel is background.
+//!     Ok(reduction.read(ctx)?.and_then(|raw| raw.view_depth_bounds(camera).ok()))
 //! }
-//! # Ok::<(), shadowmap_wgpu::BackendError>(())
 //! ```
 
 use glam::DVec4;
