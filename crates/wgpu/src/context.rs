@@ -95,6 +95,60 @@ impl GpuContext {
         format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
     }
 
+    /// Maps a `MAP_READ` buffer, waits for it, and hands its bytes to `read`; the
+    /// buffer is unmapped afterwards.
+    pub(crate) fn read_mapped<T>(
+        &self,
+        buffer: &wgpu::Buffer,
+        read: impl FnOnce(&[u8]) -> T,
+    ) -> Result<T, BackendError> {
+        let slice = buffer.slice(..);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = sender.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| BackendError::Readback(e.to_string()))?;
+        receiver
+            .recv()
+            .map_err(|e| BackendError::Readback(e.to_string()))?
+            .map_err(|e| BackendError::Readback(e.to_string()))?;
+        let value = {
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| BackendError::Readback(e.to_string()))?;
+            read(&view)
+        };
+        buffer.unmap();
+        Ok(value)
+    }
+
+    /// Reads every layer of a `Depth32Float` texture (mip 0) back: layer-major, then
+    /// row-major, row 0 at the top. Waits for the GPU.
+    ///
+    /// # Errors
+    /// [`BackendError::InvalidInput`] for another format or a texture without
+    /// `COPY_SRC`; [`BackendError::Readback`] if mapping fails.
+    pub fn read_depth_texture(&self, texture: &wgpu::Texture) -> Result<Vec<f32>, BackendError> {
+        if texture.format() != wgpu::TextureFormat::Depth32Float {
+            return Err(BackendError::InvalidInput("not a Depth32Float texture"));
+        }
+        if !texture.usage().contains(wgpu::TextureUsages::COPY_SRC) {
+            return Err(BackendError::InvalidInput("depth texture lacks COPY_SRC"));
+        }
+        let bytes = crate::depth::read_texture(
+            self,
+            texture,
+            wgpu::TextureAspect::DepthOnly,
+            texture.width(),
+            texture.height(),
+            texture.depth_or_array_layers(),
+            4,
+        )?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
     /// Runs `f` inside validation and out-of-memory error scopes, waits for the GPU,
     /// and turns any captured error into [`BackendError::Wgpu`].
     ///

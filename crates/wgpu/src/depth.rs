@@ -604,16 +604,7 @@ impl ShadowDepthPass {
     /// # Errors
     /// [`BackendError::Readback`] if mapping fails.
     pub fn readback_depth(&self, ctx: &GpuContext) -> Result<Vec<f32>, BackendError> {
-        let bytes = read_texture(
-            ctx,
-            &self.texture,
-            wgpu::TextureAspect::DepthOnly,
-            self.desc.resolution,
-            self.desc.resolution,
-            self.desc.layers,
-            4,
-        )?;
-        Ok(bytemuck::pod_collect_to_vec(&bytes))
+        ctx.read_depth_texture(&self.texture)
     }
 }
 
@@ -719,27 +710,13 @@ pub(crate) fn read_texture(
         },
     );
     ctx.queue.submit([encoder.finish()]);
-    let slice = buffer.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| BackendError::Readback(e.to_string()))?;
-    rx.recv()
-        .map_err(|e| BackendError::Readback(e.to_string()))?
-        .map_err(|e| BackendError::Readback(e.to_string()))?;
-    let mapped = slice
-        .get_mapped_range()
-        .map_err(|e| BackendError::Readback(e.to_string()))?;
-    let mut out = Vec::with_capacity((row * height * layers) as usize);
-    for chunk in mapped.chunks(padded as usize) {
-        out.extend_from_slice(&chunk[..row as usize]);
-    }
-    drop(mapped);
-    buffer.unmap();
-    Ok(out)
+    ctx.read_mapped(&buffer, |mapped| {
+        let mut out = Vec::with_capacity((row * height * layers) as usize);
+        for chunk in mapped.chunks(padded as usize) {
+            out.extend_from_slice(&chunk[..row as usize]);
+        }
+        out
+    })
 }
 
 /// How finely [`subdivide_for_rtw`] splits casters.

@@ -337,26 +337,7 @@ pub(crate) fn read_buffer(
     ctx: &GpuContext,
     buffer: &wgpu::Buffer,
 ) -> Result<Vec<u32>, BackendError> {
-    let slice = buffer.slice(..);
-    let (sender, receiver) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = sender.send(r);
-    });
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| BackendError::Readback(e.to_string()))?;
-    receiver
-        .recv()
-        .map_err(|e| BackendError::Readback(e.to_string()))?
-        .map_err(|e| BackendError::Readback(e.to_string()))?;
-    let words = {
-        let view = slice
-            .get_mapped_range()
-            .map_err(|e| BackendError::Readback(e.to_string()))?;
-        bytemuck::pod_collect_to_vec::<u8, u32>(&view)
-    };
-    buffer.unmap();
-    Ok(words)
+    ctx.read_mapped(buffer, bytemuck::pod_collect_to_vec::<u8, u32>)
 }
 
 #[cfg(test)]

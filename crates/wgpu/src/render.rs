@@ -662,12 +662,7 @@ impl HeadlessRenderer {
                 let blocks = paraboloid_layers(map);
                 let mut meshes = Vec::new();
                 let mut out = Vec::new();
-                for (i, side) in [Side::Front, Side::Back]
-                    .into_iter()
-                    .enumerate()
-                    .take(blocks.len())
-                {
-                    let _ = i;
+                for side in [Side::Front, Side::Back].into_iter().take(blocks.len()) {
                     subdivide_triangles(map, side, triangles, &sub, &mut out)
                         .map_err(|_| BackendError::InvalidInput("paraboloid subdivision failed"))?;
                     meshes.push(MeshBuffers::from_triangles(ctx, &out)?);

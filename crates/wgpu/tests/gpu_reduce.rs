@@ -145,63 +145,6 @@ fn depth_texture(ctx: &GpuContext, width: u32, height: u32, depths: &[f32]) -> w
     depth
 }
 
-/// The depth texture's content, as the GPU holds it.
-fn read_depth(ctx: &GpuContext, depth: &wgpu::Texture) -> Result<Vec<f32>, BackendError> {
-    let (width, height) = (depth.width(), depth.height());
-    let row_bytes = (width * 4).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("depth readback"),
-        size: u64::from(row_bytes * height),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture: depth,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::DepthOnly,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &staging,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(row_bytes),
-                rows_per_image: Some(height),
-            },
-        },
-        depth.size(),
-    );
-    ctx.queue.submit([encoder.finish()]);
-    let slice = staging.slice(..);
-    let (sender, receiver) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = sender.send(r);
-    });
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| BackendError::Readback(e.to_string()))?;
-    receiver
-        .recv()
-        .map_err(|e| BackendError::Readback(e.to_string()))?
-        .map_err(|e| BackendError::Readback(e.to_string()))?;
-    let bytes = slice
-        .get_mapped_range()
-        .map_err(|e| BackendError::Readback(e.to_string()))?
-        .to_vec();
-    staging.unmap();
-    let mut depths = Vec::with_capacity((width * height) as usize);
-    for row in bytes.chunks_exact(row_bytes as usize) {
-        depths.extend(
-            row[..(width * 4) as usize]
-                .chunks_exact(4)
-                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
-        );
-    }
-    Ok(depths)
-}
-
 /// Reduces `depths` on the GPU; returns (GPU range, CPU range of the readback).
 fn reduce(
     ctx: &GpuContext,
@@ -211,7 +154,7 @@ fn reduce(
     depths: &[f32],
 ) -> Result<(Option<RawDepthRange>, Option<RawDepthRange>), BackendError> {
     let texture = depth_texture(ctx, width, height, depths);
-    let stored = read_depth(ctx, &texture)?;
+    let stored = ctx.read_depth_texture(&texture)?;
     assert_eq!(stored.len(), depths.len());
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     reduction.encode(ctx, &mut encoder, &texture)?;
