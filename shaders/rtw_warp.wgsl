@@ -49,6 +49,24 @@ fn weight(k: u32) -> f32 {
     return params.weights[k / 4u][k % 4u];
 }
 
+// 2^k for -126 <= k <= 127, built from its bits (exact on every GPU).
+fn power_of_two(k: i32) -> f32 {
+    return bitcast<f32>(u32(k + 127) << 23u);
+}
+
+// Two factors whose product is 2^-(e + 1) for a peak of exponent e (so peak times both
+// lies in [0.5, 1)); each factor is a normal f32 even for peaks near f32::MAX or
+// subnormal peaks, and multiplying by a power of two is exact. (1, 1) for a zero peak.
+fn inverse_power_of_two_scale(peak_bits: u32) -> vec2<f32> {
+    if peak_bits == 0u {
+        return vec2<f32>(1.0);
+    }
+    let e = i32((peak_bits >> 23u) & 0xffu) - 127;
+    let total = e + 1;
+    let first = total / 2;
+    return vec2<f32>(power_of_two(-first), power_of_two(first - total));
+}
+
 @compute @workgroup_size(256, 1, 1)
 fn build_axis(
     @builtin(workgroup_id) group: vec3<u32>,
@@ -67,27 +85,28 @@ fn build_axis(
     }
     workgroupBarrier();
 
-    // The input's peak: the blur runs on m / peak (<= 1), which cannot overflow where
-    // importance saturates near f32::MAX (the CPU blurs in f64). The ratio
-    // blurred / max(blurred) is unchanged.
+    // The input's peak: the blur runs on m * 2^-e (peak * 2^-e in [0.5, 1)), which
+    // cannot overflow where importance saturates near f32::MAX (the CPU blurs in f64).
+    // The ratio blurred / max(blurred) is unchanged. No division: WGSL guarantees x / y
+    // only for |y| in [2^-126, 2^126], and GPUs that divide as x * (1 / y) flush the
+    // subnormal 1 / y of a larger peak to zero, which zeroed the whole axis.
     var local_peak = 0u;
     for (var i = lid; i < n; i += GROUP) {
         local_peak = max(local_peak, bitcast<u32>(maxima[offset + i]));
     }
     atomicMax(&input_max, local_peak);
     workgroupBarrier();
-    let input_peak = bitcast<f32>(atomicLoad(&input_max));
-    let input_scale = select(1.0, input_peak, input_peak > 0.0);
+    let input_scale = inverse_power_of_two_scale(atomicLoad(&input_max));
 
     // Blur and its maximum.
     var local_max = 0.0;
     for (var i = lid; i < n; i += GROUP) {
-        var acc = weight(0u) * (maxima[offset + i] / input_scale);
+        var acc = weight(0u) * (maxima[offset + i] * input_scale.x * input_scale.y);
         for (var k = 1u; k <= radius; k++) {
             let lo = u32(clamp(i32(i) - i32(k), 0, last));
             let hi = u32(clamp(i32(i + k), 0, last));
-            acc += weight(k) * (maxima[offset + lo] / input_scale)
-                + weight(k) * (maxima[offset + hi] / input_scale);
+            acc += weight(k) * (maxima[offset + lo] * input_scale.x * input_scale.y)
+                + weight(k) * (maxima[offset + hi] * input_scale.x * input_scale.y);
         }
         scratch[offset + i] = acc;
         local_max = max(local_max, acc);
