@@ -29,7 +29,8 @@ use shadowmap_paraboloid::{
     subdivide_triangles,
 };
 use shadowmap_rtw::{
-    EyeSample, ImportanceMap, ImportanceOptions, OracleAxis, RtwShadow, WarpMaps, WarpOptions,
+    EyeSample, ImportanceMap, ImportanceOptions, OracleAxis, RtwShadow, RtwSubdivision, WarpMaps,
+    WarpOptions, subdivide_for_rtw,
 };
 use shadowmap_warp::{
     FocusScene, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
@@ -536,12 +537,17 @@ impl Technique {
                     base: *base,
                     warps: warps.as_ref(),
                 };
-                // The depth pass warps vertices only: split triangles until every
-                // edge's linear image stays within RTW_TOLERANCE_TEXELS of the warp.
-                let side = f64::from(self.side);
-                let texel_of = |p: DVec3| shadow.map_point(p).map(|s| s.uv * side);
-                let fine =
-                    subdivide_adaptive(mesh, &texel_of, side, RTW_TOLERANCE_TEXELS, RTW_MAX_LEVELS);
+                // The depth pass warps vertices only: the same crack-free caster
+                // subdivision as the GPU depth pass, for a map of this side.
+                let triangles: Vec<[Vec3; 3]> =
+                    mesh.triangles().map(|t| t.map(DVec3::as_vec3)).collect();
+                let subdivision = RtwSubdivision::default().with_resolution(self.side);
+                let mut pieces = Vec::new();
+                subdivide_for_rtw(&shadow, &triangles, &subdivision, &mut pieces);
+                let mut fine = Mesh::new();
+                for t in &pieces {
+                    fine.push_triangle(t.map(Vec3::as_dvec3));
+                }
                 rasterize_depth(&fine, &RtwProjector::from(shadow), &options)
             }
             Inner::Paraboloid(map) => self.rasterize_paraboloid(map, mesh, &options),
@@ -577,70 +583,6 @@ impl Technique {
         }
         Ok(out)
     }
-}
-
-/// Largest distance, in warped texels, between an edge's linear image and the
-/// warped curve in RTW's depth pass.
-const RTW_TOLERANCE_TEXELS: f64 = 0.25;
-/// Most halvings of a triangle's edges for RTW's depth pass.
-const RTW_MAX_LEVELS: u32 = 9;
-
-/// Splits triangles 4-way (at edge midpoints) until the image of every edge under
-/// `texel_of` deviates from its chord by at most `tolerance` at the quarter points,
-/// or `max_levels` splits. Triangles that cannot reach the map `[0, extent]²` (all
-/// vertices beyond one of its sides) or that `texel_of` cannot map are kept whole.
-fn subdivide_adaptive(
-    mesh: &Mesh,
-    texel_of: &dyn Fn(DVec3) -> Option<glam::DVec2>,
-    extent: f64,
-    tolerance: f64,
-    max_levels: u32,
-) -> Mesh {
-    let bends = |a: DVec3, b: DVec3, ta: glam::DVec2, tb: glam::DVec2| -> bool {
-        [0.25, 0.5, 0.75].iter().any(|&t| {
-            texel_of(a.lerp(b, t)).is_some_and(|m| (m - ta.lerp(tb, t)).length() > tolerance)
-        })
-    };
-    let mut out = Mesh::new();
-    let mut stack: Vec<([DVec3; 3], u32)> = Vec::new();
-    for tri in mesh.triangles() {
-        stack.push((tri, 0));
-        while let Some((t, level)) = stack.pop() {
-            let texels = [texel_of(t[0]), texel_of(t[1]), texel_of(t[2])];
-            let split = level < max_levels
-                && match texels {
-                    [Some(a), Some(b), Some(c)] => {
-                        let lo = a.min(b).min(c);
-                        let hi = a.max(b).max(c);
-                        // Only triangles that can reach the map need to be exact.
-                        hi.x >= 0.0
-                            && hi.y >= 0.0
-                            && lo.x <= extent
-                            && lo.y <= extent
-                            && (bends(t[0], t[1], a, b)
-                                || bends(t[1], t[2], b, c)
-                                || bends(t[2], t[0], c, a))
-                    }
-                    _ => false,
-                };
-            if split {
-                let m01 = (t[0] + t[1]) * 0.5;
-                let m12 = (t[1] + t[2]) * 0.5;
-                let m20 = (t[2] + t[0]) * 0.5;
-                for piece in [
-                    [t[0], m01, m20],
-                    [m01, t[1], m12],
-                    [m20, m12, t[2]],
-                    [m01, m12, m20],
-                ] {
-                    stack.push((piece, level + 1));
-                }
-            } else {
-                out.push_triangle(t);
-            }
-        }
-    }
-    out
 }
 
 /// One layer of a projector, as layer 0.

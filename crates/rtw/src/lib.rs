@@ -133,6 +133,7 @@ extern crate alloc;
 
 mod error;
 mod importance;
+mod subdivide;
 mod table;
 mod warp;
 
@@ -141,6 +142,7 @@ pub use importance::{
     AccumulateStats, EyeSample, ImportanceMap, ImportanceOptions, MAX_MAP_CELLS, MAX_MAP_SIDE,
     OracleAxis,
 };
+pub use subdivide::{RtwSubdivision, subdivide_for_rtw};
 pub use table::{
     forward_warp, forward_warp_f64, inverse_warp, inverse_warp_f64, sample_table, sample_table_f64,
 };

@@ -1,0 +1,355 @@
+//! Caster subdivision for RTW's depth pass.
+//!
+//! The depth pass of rectilinear texture warping (Rosen, *Rectilinear Texture Warping
+//! for Fast Adaptive Shadow Mapping*, I3D 2012) warps vertices only, and the warp is
+//! piecewise linear between the tables' texel centres, so a long caster edge stays
+//! straight where the warped map bends it. [`subdivide_for_rtw`] splits edges until
+//! their straight warped images follow the warp within a bound in map texels. The
+//! split of an edge depends on its two endpoints alone, so shared edges split alike and
+//! a conforming mesh stays conforming (no T-junctions, hence no cracks): the same
+//! property as the paraboloid subdivision of `shadowmap-paraboloid`. Both the CPU
+//! reference rasterizer and the GPU depth pass render the mesh this function returns.
+
+use alloc::vec::Vec;
+
+use glam::{DVec2, Vec3};
+
+use crate::{RtwShadow, forward_warp_f64};
+
+/// How finely [`subdivide_for_rtw`] splits casters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct RtwSubdivision {
+    /// Texels per side of the shadow map the casters are rendered into (the error
+    /// bound is in its texels), `>= 1`. Default 1024.
+    pub resolution: u32,
+    /// Largest distance, in map texels, between the warped midpoint of an edge
+    /// and the midpoint of its straight warped image, `>= 1/64`. Default 0.25:
+    /// straight pieces that miss the bent warp by more leave acne smudges on steep
+    /// receivers (the slope-scaled bias absorbs less).
+    pub max_error_texels: f64,
+    /// Longest piece, in warp-table cells (`max(|du| N_u, |dv| N_v)` in base texture
+    /// space), `>= 1/64`, whatever the midpoint error: a midpoint test cannot see
+    /// kinks that cancel out over a long edge. Default 2.
+    pub max_span_cells: f64,
+    /// Most pieces an original edge is cut into, in `1..=1024` (rounded up to a power
+    /// of two): caps the triangle count at `max_segments²` per caster. Default 32.
+    /// The cost is real: the city block (5264 triangles) over 256-cell tables into a
+    /// 2048² map under a strong warp becomes 0.72 M triangles in 64 ms with the
+    /// defaults, 4.8 M in 1.1 s with a cap of 256 (`cargo bench -p shadowmap-wgpu --bench frame`).
+    pub max_segments: u32,
+}
+
+impl Default for RtwSubdivision {
+    fn default() -> Self {
+        Self {
+            resolution: 1024,
+            max_error_texels: 0.25,
+            max_span_cells: 2.0,
+            max_segments: 32,
+        }
+    }
+}
+
+impl RtwSubdivision {
+    /// For a map of this many texels per side.
+    #[must_use]
+    pub const fn with_resolution(mut self, resolution: u32) -> Self {
+        self.resolution = resolution;
+        self
+    }
+    /// With this midpoint error bound, in map texels.
+    #[must_use]
+    pub const fn with_max_error_texels(mut self, texels: f64) -> Self {
+        self.max_error_texels = texels;
+        self
+    }
+    /// With this longest piece, in table cells.
+    #[must_use]
+    pub const fn with_max_span_cells(mut self, cells: f64) -> Self {
+        self.max_span_cells = cells;
+        self
+    }
+    /// With this cap on pieces per edge.
+    #[must_use]
+    pub const fn with_max_segments(mut self, max_segments: u32) -> Self {
+        self.max_segments = max_segments;
+        self
+    }
+}
+
+/// Splits triangles for the RTW depth pass, which warps only vertices: the warp is
+/// piecewise linear between the tables' texel centres, so a long edge stays straight
+/// where the warped map bends it. An edge is halved when it spans more than
+/// `max_span_cells` table cells or its warped midpoint lies more than
+/// `max_error_texels` map texels from the midpoint of its straight warped image;
+/// the pieces are tested again, until the original edge has been halved
+/// `ceil(log2(max_segments))` times. Out-of-range options are clamped to their
+/// documented ranges (NaN: the default). Writes into `out` (cleared first) and
+/// returns its length.
+///
+/// Whether an edge splits depends on its two endpoints alone, and its midpoint is
+/// symmetric in them, so two triangles sharing an edge split it identically: a
+/// conforming mesh stays conforming (no T-junctions, hence no cracks between warped
+/// neighbours). A triangle with one edge split becomes 2, two edges 3, three edges
+/// 4 (the midpoint triangle), each recursed into.
+///
+/// Triangles with a vertex the base projection cannot map (behind a perspective
+/// light) or with non-finite vertices are passed through unsplit.
+pub fn subdivide_for_rtw(
+    shadow: &RtwShadow<'_>,
+    triangles: &[[Vec3; 3]],
+    options: &RtwSubdivision,
+    out: &mut Vec<[Vec3; 3]>,
+) -> usize {
+    out.clear();
+    let defaults = RtwSubdivision::default();
+    let at_least = |x: f64, default: f64| {
+        if x.is_nan() {
+            default
+        } else {
+            x.clamp(1.0 / 64.0, f64::MAX)
+        }
+    };
+    let max_span = at_least(options.max_span_cells, defaults.max_span_cells);
+    let max_error = at_least(options.max_error_texels, defaults.max_error_texels);
+    let splitter = RtwSplitter {
+        shadow,
+        pieces: DVec2::new(
+            shadow.warps.x_table().len() as f64,
+            shadow.warps.y_table().len() as f64,
+        ) / max_span,
+        error_scale: f64::from(options.resolution.max(1)) / max_error,
+    };
+    let levels = options
+        .max_segments
+        .clamp(1, 1024)
+        .next_power_of_two()
+        .trailing_zeros();
+    for &t in triangles {
+        if t.iter().all(|p| p.is_finite() && splitter.uv(*p).is_some()) {
+            splitter.split(t, levels, out);
+        } else {
+            out.push(t);
+        }
+    }
+    out.len()
+}
+
+/// The per-edge split rule of [`subdivide_for_rtw`].
+struct RtwSplitter<'a, 'b> {
+    shadow: &'a RtwShadow<'b>,
+    /// Pieces per unit of base texture space along `u` and `v` (table texels over
+    /// the longest piece in cells).
+    pieces: DVec2,
+    /// Map texels over the error bound: warped-uv error times this above 1 splits.
+    error_scale: f64,
+}
+
+impl RtwSplitter<'_, '_> {
+    fn uv(&self, p: Vec3) -> Option<DVec2> {
+        self.shadow
+            .base
+            .project(p)
+            .map(|s| s.uv)
+            .filter(|uv| uv.is_finite())
+    }
+
+    fn warp(&self, uv: DVec2) -> DVec2 {
+        DVec2::new(
+            forward_warp_f64(self.shadow.warps.x_table(), uv.x),
+            forward_warp_f64(self.shadow.warps.y_table(), uv.y),
+        )
+    }
+
+    /// The midpoint of `a b` if the edge is longer than a piece or its straight
+    /// warped image misses the warped midpoint by more than the bound. Symmetric
+    /// in `a, b`: both triangles of a shared edge decide alike and get the same
+    /// point.
+    fn midpoint(&self, a: Vec3, b: Vec3) -> Option<Vec3> {
+        let (ua, ub) = (self.uv(a)?, self.uv(b)?);
+        let mid = ((a.as_dvec3() + b.as_dvec3()) * 0.5).as_vec3();
+        let span = ((ub - ua).abs() * self.pieces).max_element();
+        if span > 1.0 {
+            return Some(mid);
+        }
+        let chord = (self.warp(ua) + self.warp(ub)) * 0.5;
+        let error = (self.warp(self.uv(mid)?) - chord).abs().max_element();
+        (error * self.error_scale > 1.0).then_some(mid)
+    }
+
+    fn split(&self, t: [Vec3; 3], levels: u32, out: &mut Vec<[Vec3; 3]>) {
+        let [a, b, c] = t;
+        if levels == 0 {
+            out.push(t);
+            return;
+        }
+        let next = levels - 1;
+        let mid = [
+            self.midpoint(a, b),
+            self.midpoint(b, c),
+            self.midpoint(c, a),
+        ];
+        // Rotate so the split edges come first (same winding throughout).
+        match mid {
+            [None, None, None] => out.push(t),
+            [Some(m), None, None] => self.split_one([a, b, c], m, next, out),
+            [None, Some(m), None] => self.split_one([b, c, a], m, next, out),
+            [None, None, Some(m)] => self.split_one([c, a, b], m, next, out),
+            [Some(m), Some(n), None] => self.split_two([a, b, c], m, n, next, out),
+            [None, Some(m), Some(n)] => self.split_two([b, c, a], m, n, next, out),
+            [Some(n), None, Some(m)] => self.split_two([c, a, b], m, n, next, out),
+            [Some(ab), Some(bc), Some(ca)] => {
+                for piece in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]] {
+                    self.split(piece, next, out);
+                }
+            }
+        }
+    }
+
+    /// `[a, b, c]` with `m` the midpoint of `a b`.
+    fn split_one(&self, [a, b, c]: [Vec3; 3], m: Vec3, levels: u32, out: &mut Vec<[Vec3; 3]>) {
+        self.split([a, m, c], levels, out);
+        self.split([m, b, c], levels, out);
+    }
+
+    /// `[a, b, c]` with `m` the midpoint of `a b` and `n` that of `b c`: the corner
+    /// `m b n`, and the quad `a m n c` cut along its shorter diagonal.
+    fn split_two(
+        &self,
+        [a, b, c]: [Vec3; 3],
+        m: Vec3,
+        n: Vec3,
+        levels: u32,
+        out: &mut Vec<[Vec3; 3]>,
+    ) {
+        self.split([m, b, n], levels, out);
+        if a.distance_squared(n) <= m.distance_squared(c) {
+            self.split([a, m, n], levels, out);
+            self.split([a, n, c], levels, out);
+        } else {
+            self.split([a, m, c], levels, out);
+            self.split([m, n, c], levels, out);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
+    use glam::{Mat4, Vec2};
+    use shadowmap_frustum::{LightDirection, ShadowTransform};
+
+    /// An identity base (`uv = (x, y)` for `x, y` in `[0, 1]`) over 16 x 8 tables.
+    fn warps() -> WarpMaps {
+        let mut importance = ImportanceMap::new(16, 8).unwrap();
+        importance.splat(Vec2::new(0.3, 0.6), 1.0).unwrap();
+        let mut warps = WarpMaps::new(16, 8).unwrap();
+        warps.build(&importance, &WarpOptions::default()).unwrap();
+        warps
+    }
+
+    fn shadow(warps: &WarpMaps) -> RtwShadow<'_> {
+        // clip x = 2u - 1, y = 1 - 2v: uv_from_world is the identity on x, y.
+        let clip_from_world = Mat4::from_cols_array(&[
+            2.0, 0.0, 0.0, 0.0, 0.0, -2.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, -1.0, 1.0, 0.0, 1.0,
+        ]);
+        let base = ShadowTransform::new(
+            Mat4::IDENTITY,
+            clip_from_world,
+            false,
+            LightDirection::Directional(Vec3::NEG_Z),
+        );
+        RtwShadow { base, warps }
+    }
+
+    fn area(t: &[Vec3; 3]) -> f32 {
+        0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
+    }
+
+    #[test]
+    fn pieces_span_at_most_one_cell_and_keep_the_area() {
+        let warps = warps();
+        let shadow = shadow(&warps);
+        let t = [
+            Vec3::new(0.05, 0.1, 0.5),
+            Vec3::new(0.95, 0.2, 0.5),
+            Vec3::new(0.4, 0.9, 0.5),
+        ];
+        let mut out = Vec::new();
+        // Span alone (a huge error bound).
+        let one_cell = RtwSubdivision::default()
+            .with_max_span_cells(1.0)
+            .with_max_error_texels(1e9);
+        let n = subdivide_for_rtw(&shadow, &[t], &one_cell, &mut out);
+        assert!(n > 16, "split into {n}");
+        for piece in &out {
+            for (p, q) in [
+                (piece[0], piece[1]),
+                (piece[1], piece[2]),
+                (piece[2], piece[0]),
+            ] {
+                let span = ((q.x - p.x).abs() * 16.0).max((q.y - p.y).abs() * 8.0);
+                assert!(span <= 1.0 + 1e-5, "edge spans {span} cells");
+            }
+        }
+        let total: f32 = out.iter().map(area).sum();
+        assert!((total - area(&t)).abs() < 1e-5 * area(&t).max(1.0));
+        // The error bound splits further on a fine map; on a one-texel map with a
+        // one-texel bound (the warp stays in [0, 1]) it never splits.
+        let fine = one_cell.with_max_error_texels(0.25).with_resolution(4096);
+        assert!(subdivide_for_rtw(&shadow, &[t], &fine, &mut out) > n);
+        let coarse = one_cell.with_max_error_texels(1.0).with_resolution(1);
+        assert_eq!(subdivide_for_rtw(&shadow, &[t], &coarse, &mut out), n);
+        // Capped: at most 2 halvings per edge, so at most 4^2 pieces.
+        let capped = one_cell.with_max_segments(4);
+        assert!(subdivide_for_rtw(&shadow, &[t], &capped, &mut out) <= 16);
+        let unsplit = one_cell.with_max_segments(1);
+        assert_eq!(subdivide_for_rtw(&shadow, &[t], &unsplit, &mut out), 1);
+    }
+
+    #[test]
+    fn a_shared_edge_splits_identically_on_both_sides() {
+        let warps = warps();
+        let shadow = shadow(&warps);
+        let (p, q) = (Vec3::new(0.1, 0.1, 0.0), Vec3::new(0.9, 0.8, 0.0));
+        // Very different third vertices: one side would split far more if the edge
+        // were decided per triangle.
+        let left = [p, q, Vec3::new(0.12, 0.75, 0.0)];
+        let right = [q, p, Vec3::new(0.99, 0.02, 0.0)];
+        let on_edge = |tris: &[[Vec3; 3]]| {
+            let mut v: Vec<[u32; 3]> = tris
+                .iter()
+                .flatten()
+                .filter(|x| {
+                    let d = (q - p).cross(**x - p).length();
+                    d < 1e-6
+                })
+                .map(|x| x.to_array().map(f32::to_bits))
+                .collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        };
+        let mut a = Vec::new();
+        let mut b = Vec::new();
+        let options = RtwSubdivision::default();
+        subdivide_for_rtw(&shadow, &[left], &options, &mut a);
+        subdivide_for_rtw(&shadow, &[right], &options, &mut b);
+        let (ea, eb) = (on_edge(&a), on_edge(&b));
+        assert!(ea.len() > 2, "the shared edge was split");
+        assert_eq!(ea, eb);
+    }
+
+    #[test]
+    fn unmappable_or_non_finite_triangles_pass_through() {
+        let warps = warps();
+        let shadow = shadow(&warps);
+        let bad = [Vec3::NAN, Vec3::X, Vec3::Y];
+        let mut out = Vec::new();
+        let options = RtwSubdivision::default();
+        assert_eq!(subdivide_for_rtw(&shadow, &[bad], &options, &mut out), 1);
+        assert!(out[0][0].is_nan());
+    }
+}
