@@ -142,44 +142,44 @@ pub mod rtw;
 
 /// The WGSL sources in `shaders/`, embedded so users need no file access.
 pub mod shaders {
-    // Each author adds `pub const NAME: &str = include_str!("../../../shaders/<file>.wgsl");`
+    // Each author adds `pub const NAME: &str = include_str!("../shaders/<file>.wgsl");`
     // for the files they own, with a one-line doc comment.
 
     // --- depth passes, lookups, filters, renderer (depth_*, lookup_*, filter_*, render_*) ---
     /// Depth pass of the matrix techniques (uniform, cascades, LiSPSM, XPSM, TSM).
-    pub const DEPTH_MATRIX: &str = include_str!("../../../shaders/depth_matrix.wgsl");
+    pub const DEPTH_MATRIX: &str = include_str!("../shaders/depth_matrix.wgsl");
     /// Depth pass of a paraboloid map (one side per layer, hemisphere clipped).
-    pub const DEPTH_PARABOLOID: &str = include_str!("../../../shaders/depth_paraboloid.wgsl");
+    pub const DEPTH_PARABOLOID: &str = include_str!("../shaders/depth_paraboloid.wgsl");
     /// Depth pass of RTW (base projection, then the warp tables per axis).
-    pub const DEPTH_RTW: &str = include_str!("../../../shaders/depth_rtw.wgsl");
+    pub const DEPTH_RTW: &str = include_str!("../shaders/depth_rtw.wgsl");
     /// Lookup of a matrix technique (uniform, LiSPSM, XPSM with its Z bias, TSM).
-    pub const LOOKUP_MATRIX: &str = include_str!("../../../shaders/lookup_matrix.wgsl");
+    pub const LOOKUP_MATRIX: &str = include_str!("../shaders/lookup_matrix.wgsl");
     /// Lookup of cascades: selection by view depth with the blend band, or by projection.
-    pub const LOOKUP_CASCADES: &str = include_str!("../../../shaders/lookup_cascades.wgsl");
+    pub const LOOKUP_CASCADES: &str = include_str!("../shaders/lookup_cascades.wgsl");
     /// Lookup of a paraboloid map (front/back side, cut).
-    pub const LOOKUP_PARABOLOID: &str = include_str!("../../../shaders/lookup_paraboloid.wgsl");
+    pub const LOOKUP_PARABOLOID: &str = include_str!("../shaders/lookup_paraboloid.wgsl");
     /// Lookup of RTW (base projection, warp tables).
-    pub const LOOKUP_RTW: &str = include_str!("../../../shaders/lookup_rtw.wgsl");
+    pub const LOOKUP_RTW: &str = include_str!("../shaders/lookup_rtw.wgsl");
     /// Filter: one nearest texel.
-    pub const FILTER_HARD: &str = include_str!("../../../shaders/filter_hard.wgsl");
+    pub const FILTER_HARD: &str = include_str!("../shaders/filter_hard.wgsl");
     /// Filter: the hardware 2x2 compare.
-    pub const FILTER_HARDWARE: &str = include_str!("../../../shaders/filter_hardware.wgsl");
+    pub const FILTER_HARDWARE: &str = include_str!("../shaders/filter_hardware.wgsl");
     /// Filter: N x N percentage-closer filtering.
-    pub const FILTER_PCF: &str = include_str!("../../../shaders/filter_pcf.wgsl");
+    pub const FILTER_PCF: &str = include_str!("../shaders/filter_pcf.wgsl");
     /// Filter: Poisson-disk percentage-closer filtering.
-    pub const FILTER_POISSON: &str = include_str!("../../../shaders/filter_poisson.wgsl");
+    pub const FILTER_POISSON: &str = include_str!("../shaders/filter_poisson.wgsl");
     /// Filter: variance shadow maps (Chebyshev bound on blurred moments).
-    pub const FILTER_VSM: &str = include_str!("../../../shaders/filter_vsm.wgsl");
+    pub const FILTER_VSM: &str = include_str!("../shaders/filter_vsm.wgsl");
     /// VSM moments pass and separable blur (full-screen fragment passes).
-    pub const FILTER_VSM_MOMENTS: &str = include_str!("../../../shaders/filter_vsm_moments.wgsl");
+    pub const FILTER_VSM_MOMENTS: &str = include_str!("../shaders/filter_vsm_moments.wgsl");
     /// The headless renderer's scene pass (a lookup and a filter are composed in).
-    pub const RENDER_SCENE: &str = include_str!("../../../shaders/render_scene.wgsl");
+    pub const RENDER_SCENE: &str = include_str!("../shaders/render_scene.wgsl");
 
     // --- compute (reduce_*, rtw_*) ---
     /// Min/max reduction of a depth buffer (two entry points: tiles, then partials).
-    pub const REDUCE_DEPTH: &str = include_str!("../../../shaders/reduce_depth.wgsl");
+    pub const REDUCE_DEPTH: &str = include_str!("../shaders/reduce_depth.wgsl");
     /// RTW importance splat from an eye-space G-buffer and collapse to 1-D maxima.
-    pub const RTW_IMPORTANCE: &str = include_str!("../../../shaders/rtw_importance.wgsl");
+    pub const RTW_IMPORTANCE: &str = include_str!("../shaders/rtw_importance.wgsl");
     /// RTW per-axis blur, normalization, temporal smoothing, floor and warp table.
-    pub const RTW_WARP: &str = include_str!("../../../shaders/rtw_warp.wgsl");
+    pub const RTW_WARP: &str = include_str!("../shaders/rtw_warp.wgsl");
 }
