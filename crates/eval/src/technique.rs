@@ -9,7 +9,7 @@
 //!
 //! | light | techniques |
 //! |---|---|
-//! | directional | uniform focused, stable cascades (PSSM, practical split), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), RTW (backward importance), RTW oracle |
+//! | directional | uniform focused, stable cascades (PSSM, practical split), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), auto (the candidate with the lowest predicted error), RTW (backward importance), RTW oracle |
 //! | spot | spot fit |
 //! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone |
 //!
@@ -21,8 +21,9 @@
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap_frustum::{
-    Camera, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light, SceneBounds,
-    ShadowMapping, ShadowSample, ShadowTransform, SplitScheme, fit_spot,
+    Camera, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light, PredictOptions,
+    SceneBounds, ShadowMapping, ShadowSample, ShadowTransform, SplitScheme, TechniqueSelector,
+    fit_spot, predict_error,
 };
 use shadowmap_paraboloid::{
     ConeFit, IpsmOptions, IpsmPlan, MapOptions, ParaboloidMap, Side, SubdivisionOptions,
@@ -63,6 +64,10 @@ pub enum TechniqueKind {
     /// Rectilinear texture warping over the uniform fit, importance from the eye's
     /// samples (backward analysis).
     Rtw,
+    /// Picks, per frame, the matrix technique or cascades with the lowest error
+    /// predicted from the camera, light and bounds alone
+    /// (`shadowmap_frustum::predict_error`; candidates in [`AUTO_CANDIDATES`]).
+    Auto,
     /// RTW fed the exact perspective-only density each axis requires
     /// (`ImportanceMap::accumulate_oracle_axis`, `WarpMaps::build_separable`).
     RtwOracle,
@@ -78,13 +83,14 @@ pub enum TechniqueKind {
 
 impl TechniqueKind {
     /// All techniques, in report order.
-    pub const ALL: [Self; 12] = [
+    pub const ALL: [Self; 13] = [
         Self::UniformFocused,
         Self::StableCascades,
         Self::Lispsm,
         Self::Xpsm,
         Self::Tsm,
         Self::WarpedCascades,
+        Self::Auto,
         Self::Rtw,
         Self::RtwOracle,
         Self::SpotFit,
@@ -103,6 +109,7 @@ impl TechniqueKind {
             Self::Xpsm => "xpsm",
             Self::Tsm => "tsm",
             Self::WarpedCascades => "warped_cascades",
+            Self::Auto => "auto",
             Self::Rtw => "rtw",
             Self::RtwOracle => "rtw_oracle",
             Self::SpotFit => "spot",
@@ -124,6 +131,7 @@ impl TechniqueKind {
                     | Self::Xpsm
                     | Self::Tsm
                     | Self::WarpedCascades
+                    | Self::Auto
                     | Self::Rtw
                     | Self::RtwOracle
             ),
@@ -247,9 +255,22 @@ enum Inner {
     },
 }
 
+/// The candidates of [`TechniqueKind::Auto`], from the most to the least preferred
+/// when predictions tie.
+pub const AUTO_CANDIDATES: [TechniqueKind; 6] = [
+    TechniqueKind::UniformFocused,
+    TechniqueKind::Lispsm,
+    TechniqueKind::Tsm,
+    TechniqueKind::Xpsm,
+    TechniqueKind::WarpedCascades,
+    TechniqueKind::StableCascades,
+];
+
 /// A technique fitted to one frame.
 pub struct Technique {
     kind: TechniqueKind,
+    /// The technique that was fitted: `kind` itself, or the candidate `auto` chose.
+    chosen: TechniqueKind,
     inner: Inner,
     layers: u32,
     side: u32,
@@ -259,6 +280,7 @@ impl core::fmt::Debug for Technique {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("Technique")
             .field("kind", &self.kind)
+            .field("chosen", &self.chosen)
             .field("layers", &self.layers)
             .field("side", &self.side)
             .finish_non_exhaustive()
@@ -293,6 +315,9 @@ impl Technique {
     ) -> Result<Self, EvalError> {
         if !kind.applies_to(frame.light) {
             return Err(fail(kind, &"not for this kind of light"));
+        }
+        if kind == TechniqueKind::Auto {
+            return Self::build_auto(frame, options);
         }
         let focus = FocusScene::new(frame.scene.receivers, frame.scene.casters);
         let camera = frame.camera;
@@ -381,6 +406,7 @@ impl Technique {
                     )
                 }
             }
+            TechniqueKind::Auto => return Self::build_auto(frame, options),
             TechniqueKind::Rtw | TechniqueKind::RtwOracle => {
                 let base = uniform_focused(camera, direction, &focus, &UniformOptions::default())
                     .map_err(|x| e(&x))?;
@@ -472,9 +498,46 @@ impl Technique {
         };
         Ok(Self {
             kind,
+            chosen: kind,
             inner,
             layers,
             side,
+        })
+    }
+
+    /// `auto`: fits every candidate, predicts each one's 95th-percentile aliasing
+    /// error with the receivers' box standing in for the surfaces, and keeps the
+    /// lowest. The report fits each frame on its own, so the selector's hysteresis
+    /// (which a renderer keeps across frames) does not apply here.
+    fn build_auto(frame: &FrameContext<'_>, options: &TechniqueOptions) -> Result<Self, EvalError> {
+        let mut fitted: Vec<Option<Self>> = Vec::with_capacity(AUTO_CANDIDATES.len());
+        let mut predictions = Vec::with_capacity(AUTO_CANDIDATES.len());
+        for kind in AUTO_CANDIDATES {
+            let technique = Self::build(kind, frame, options).ok();
+            let prediction = technique.as_ref().and_then(|t| {
+                predict_error(
+                    frame.camera,
+                    &frame.scene.receivers,
+                    t,
+                    t.side,
+                    &PredictOptions::default(),
+                )
+                .ok()
+                .flatten()
+                .map(|p| p.percentile)
+            });
+            fitted.push(technique);
+            predictions.push(prediction);
+        }
+        let index = TechniqueSelector::new()
+            .choose(&predictions)
+            .ok_or_else(|| fail(TechniqueKind::Auto, &"no candidate could be fitted"))?;
+        let chosen = fitted[index]
+            .take()
+            .ok_or_else(|| fail(TechniqueKind::Auto, &"no candidate could be fitted"))?;
+        Ok(Self {
+            kind: TechniqueKind::Auto,
+            ..chosen
         })
     }
 
@@ -482,6 +545,13 @@ impl Technique {
     #[must_use]
     pub const fn kind(&self) -> TechniqueKind {
         self.kind
+    }
+
+    /// The technique actually fitted: [`kind`](Self::kind), or for
+    /// [`TechniqueKind::Auto`] the candidate it chose.
+    #[must_use]
+    pub const fn chosen(&self) -> TechniqueKind {
+        self.chosen
     }
 
     /// Number of layers (cascades, paraboloid sides).
@@ -679,9 +749,59 @@ mod tests {
             position: Vec3::Y,
             range: 10.0,
         };
-        assert_eq!(TechniqueKind::for_light(&d).len(), 8);
+        assert_eq!(TechniqueKind::for_light(&d).len(), 9);
         assert_eq!(TechniqueKind::for_light(&p).len(), 3);
         assert!(!TechniqueKind::SpotFit.applies_to(&d));
+    }
+
+    #[test]
+    fn auto_is_the_candidate_with_the_lowest_prediction() {
+        let camera = Camera::look_to(
+            Vec3::new(0.0, 10.0, 0.0),
+            Vec3::NEG_Z,
+            Vec3::Y,
+            shadowmap_frustum::Projection::perspective(1.0, 1.5, 1.0, 300.0),
+        )
+        .unwrap();
+        let light = Light::Directional {
+            direction: Vec3::new(0.3, -1.0, 0.1),
+        };
+        let b = shadowmap_frustum::Aabb::new(
+            Vec3::new(-300.0, 0.0, -320.0),
+            Vec3::new(300.0, 30.0, 20.0),
+        );
+        let frame = FrameContext {
+            camera: &camera,
+            light: &light,
+            scene: SceneBounds {
+                receivers: b,
+                casters: b,
+            },
+            eye_samples: &[],
+            pixels_per_radian: 100.0,
+        };
+        let o = TechniqueOptions::default().with_texel_budget(256 * 256);
+        let auto = Technique::build(TechniqueKind::Auto, &frame, &o).unwrap();
+        assert_eq!(auto.kind(), TechniqueKind::Auto);
+        assert!(AUTO_CANDIDATES.contains(&auto.chosen()));
+        let predicted = |t: &Technique| {
+            predict_error(&camera, &b, t, t.side, &PredictOptions::default())
+                .unwrap()
+                .unwrap()
+                .percentile
+        };
+        let chosen = Technique::build(auto.chosen(), &frame, &o).unwrap();
+        let best = AUTO_CANDIDATES
+            .iter()
+            .filter_map(|k| Technique::build(*k, &frame, &o).ok())
+            .map(|t| predicted(&t))
+            .fold(f64::INFINITY, f64::min);
+        assert_eq!(predicted(&auto), predicted(&chosen));
+        assert_eq!(predicted(&chosen), best);
+        // A perspective view over open ground: a warp beats the uniform fit.
+        assert_ne!(auto.chosen(), TechniqueKind::UniformFocused);
+        let p = DVec3::new(1.0, 0.0, -20.0);
+        assert_eq!(auto.map_point(p), chosen.map_point(p));
     }
 
     #[test]

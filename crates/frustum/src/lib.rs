@@ -83,6 +83,7 @@ mod geometry;
 mod light;
 mod mapping;
 pub mod math;
+mod predict;
 pub mod projection;
 mod split;
 mod spot;
@@ -98,6 +99,9 @@ pub use geometry::{Aabb, Plane, Sphere};
 pub use light::{Light, directional_light_from_world};
 pub use mapping::{
     LightDirection, ShadowMapping, ShadowSample, ShadowTransform, UV_FROM_CLIP, is_invertible,
+};
+pub use predict::{
+    MAX_PREDICT_RAYS, PredictOptions, PredictedError, TechniqueSelector, predict_error,
 };
 pub use split::{CascadeBlend, CascadeSplits, MAX_CASCADES, SplitScheme};
 pub use spot::{SpotShadow, fit_spot};
