@@ -5,7 +5,7 @@ use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap_frustum::{Camera, ShadowTransform};
 
 use crate::WarpError;
-use crate::focus::{Bounds, View, finish, focus, scale_of, smoothstep, sqrt0};
+use crate::focus::{Bounds, View, finish, focus, footprint_weight, scale_of, smoothstep};
 
 /// Options of [`xpsm`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,8 +18,9 @@ pub struct XpsmOptions {
     /// critical case (casters behind the viewer). Default 0.1.
     pub epsilon_w: f32,
     /// `coef` of the paper (inverse world units): warping `1 / (coef d + 1)` at view
-    /// distance `d`. `None` (default) picks `1 / sqrt(z_n z_f)` from the visible
-    /// receivers, which equals LiSPSM's `n_opt` warp for an overhead light.
+    /// distance `d`, `lengthP = coef / cos γ`. `None` (default) picks the projection
+    /// vector whose warp equals LiSPSM's `n_opt` warp (same projection centre), faded
+    /// out with the miner's-lamp weight.
     pub coef: Option<f32>,
     /// `|V_xy|` (the sine of the angle between view and light) below which the
     /// miner's-lamp case applies: orthographic shadows with focusing. The paper
@@ -151,7 +152,11 @@ type Cloud = ArrayVec<Hom, 1100>;
 /// 4. `minCastersProj`, `minReceiversProj`: smallest projections on `unit P`.
 /// 5. `maxLengthP = (epsilonW - 1) / max(minCastersProj, minReceiversProj)` when the
 ///    focus interval starts behind the viewer (no bound otherwise).
-/// 6. `lengthP = coef / cos γ`, `cos γ = |V_xy|`.
+/// 6. `lengthP = coef / cos γ`, `cos γ = |V_xy|`, for a given
+///    [`XpsmOptions::coef`]; by default the length whose warp has LiSPSM's `n_opt`
+///    projection centre (`lengthP = s / (1 + s (y_eye - y_0))`, `s = 1 / n_opt`,
+///    `y_0` the near face of the focus body on the warp axis), since the paper's
+///    fixed `coef` over-warps as the light turns toward the view.
 /// 7. Clip: `lengthP = min(lengthP, maxLengthP)` when `maxLengthP > 0`. Then two
 ///    precision guards: `1 + lengthP * maxProj <= MAX_WARP_RATIO` and
 ///    `lengthP <= MAX_WARP_RATIO / L` ([`MAX_WARP_RATIO`](crate::MAX_WARP_RATIO)).
@@ -242,15 +247,11 @@ pub fn xpsm(
     } else {
         f64::INFINITY
     };
-    // Step 6: optimal length, coef / cos(gamma) with cos(gamma) = |V_xy|.
-    let coef = match options.coef {
-        Some(c) => f64::from(c),
-        None => auto_coef(&f.receivers, &view),
-    };
-    let mut length_p = if weight > 0.0 {
-        weight * coef / v_xy
-    } else {
-        0.0
+    // Step 6: optimal length.
+    let mut length_p = match options.coef {
+        Some(c) if weight > 0.0 => weight * f64::from(c) / v_xy,
+        Some(_) => 0.0,
+        None => auto_length(&f, &view, weight),
     };
     // Step 7: clip against the back-projection singularity.
     if max_length_p > 0.0 && length_p > max_length_p {
@@ -262,7 +263,18 @@ pub fn xpsm(
     }
     // The f32 matrix computes w in world coordinates: keep its rounding small (see
     // MAX_WARP_RATIO).
-    length_p = length_p.min(crate::MAX_WARP_RATIO / scale_of(&f.casters));
+    let world_scale = scale_of(&f.casters).max(
+        f.caster_box
+            .min
+            .abs()
+            .max(f.caster_box.max.abs())
+            .max_element()
+            .into(),
+    );
+    length_p = length_p.min(crate::MAX_WARP_RATIO / world_scale);
+    // A footprint too thin for f32 texels gets the widened uniform fit.
+    let wide = footprint_weight(&f.rot, &f.receivers, scale_of(&f.receivers));
+    length_p *= wide;
     if !(length_p.is_finite() && length_p >= 0.0) {
         length_p = 0.0;
     }
@@ -318,7 +330,7 @@ pub fn xpsm(
     // Step 14: Z range over both boxes (points with w < epsilonW excluded).
     region.min.z = cz.0.min(rz.0);
     region.max.z = cz.1.max(rz.1);
-    let region = region.padded(scale_of(&f.casters));
+    let region = region.padded(world_scale, 1.0 - wide);
     let (min, max) = (region.min, region.max);
     let ext = max - min;
     // Step 15: unit cube = inverse of the focus region basis.
@@ -347,7 +359,7 @@ pub fn xpsm(
     };
     // Step 17: the final transformation (View * LightSpace folded into light_space).
     let clip = normalized * unit_cube * ppls * light_space;
-    let transform = finish(f.rot, clip, options.reversed_z, f.light)?;
+    let transform = finish(f.rot, clip, options.reversed_z, f.light, world_scale)?;
     // Step 18: Z bias scale, 1 / (MaxZ - MinZ).
     let z_bias_scale = (1.0 / ext.z) as f32;
     if !(z_bias_scale.is_finite() && z_bias_scale > 0.0) {
@@ -362,19 +374,29 @@ pub fn xpsm(
     })
 }
 
-/// `1 / sqrt(z_n z_f)` over the visible receivers' view depths.
-fn auto_coef(receivers: &[DVec3], view: &View) -> f64 {
-    let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
-    for p in receivers {
-        let d = (*p - view.eye).dot(view.forward);
-        z_n = z_n.min(d);
-        z_f = z_f.max(d);
+/// The automatic `lengthP`: the projection vector whose warp equals LiSPSM's at
+/// `eta = 0` (`n_opt`), faded by `weight`.
+///
+/// LiSPSM's warp is `w ∝ 1 + s (y - y_0)` (`y_0` the near face of the body on the
+/// warp axis), XPSM's `w = 1 + lengthP p`, `p = y - y_eye`; they have the same
+/// projection centre, hence the same map after the focus fit, when
+/// `lengthP = s / (1 + s (y_eye - y_0))`. The paper's `coef / cos γ` with a fixed
+/// `coef` grows as the light turns toward the view (`1 / sin γ` here) and puts the
+/// centre relative to the viewer, not to the visible region: with the light near the
+/// view (a camera looking down, a low sun ahead) the visible region reaches far
+/// behind the viewer along the warp axis and the clip of step 7 then drives the warp
+/// to its `epsilonW` limit, which magnifies one edge of the map and starves the rest.
+/// When the centre would lie beyond the viewer (`1 + s (y_eye - y_0) <= 0`) the
+/// length is left unbounded here and clipped by step 7 and the precision guards.
+fn auto_length(f: &crate::focus::Focus, view: &View, weight: f64) -> f64 {
+    let s = crate::lispsm::strength(f, view, 0.0, (0.0, f64::INFINITY), weight);
+    if !(s > 0.0) {
+        return 0.0;
     }
-    let z_scale = z_f.abs().max(z_n.abs()).max(f64::MIN_POSITIVE);
-    let z_n = z_n.max(1e-6 * z_scale);
-    let z_f = z_f.max(z_n);
-    let c = 1.0 / sqrt0(z_n * z_f);
-    if c.is_finite() { c } else { 0.0 }
+    let (y0, _) = f.warp_axis_range();
+    let y_eye = f.rot.transform_point3(view.eye).y;
+    let k = 1.0 + s * (y_eye - y0);
+    if k > 1e-9 { s / k } else { f64::INFINITY }
 }
 
 /// PPLS points of a vertex set, split by the plane `w = eps_w`: every vertex (those
