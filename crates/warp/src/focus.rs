@@ -222,6 +222,90 @@ pub(crate) fn focus(view: &View, light: Vec3, scene: &FocusScene) -> Result<Focu
     })
 }
 
+/// The first stage of every technique, built once per frame and shared: the checked
+/// camera (or one slice of it), light and scene, the light frame
+/// ([`light_frame`](crate::light_frame)) and the focus body (frustum ∩ receivers,
+/// and the casters that can shadow it).
+///
+/// Build it with [`FocusBody::new`], then fit any number of techniques from it
+/// ([`FocusBody::uniform`], [`FocusBody::lispsm`], [`FocusBody::xpsm`],
+/// [`FocusBody::tsm`]) without repeating the validation, the clipping or the frame.
+/// The free functions ([`uniform_focused`](crate::uniform_focused),
+/// [`lispsm`](crate::lispsm), ...) build one and call these.
+///
+/// ```
+/// use glam::Vec3;
+/// use shadowmap_frustum::{Aabb, Camera, Projection};
+/// use shadowmap_warp::{FocusBody, FocusScene, LispsmOptions, TsmOptions};
+///
+/// let camera = Camera::look_to(
+///     Vec3::new(0.0, 2.0, 0.0),
+///     Vec3::NEG_Z,
+///     Vec3::Y,
+///     Projection::perspective(1.0, 1.5, 0.5, 100.0),
+/// )?;
+/// let scene = FocusScene::whole(Aabb::new(Vec3::splat(-50.0), Vec3::splat(50.0)));
+/// let body = FocusBody::new(&camera, Vec3::new(0.3, -1.0, -0.2), &scene)?;
+/// let l = body.lispsm(&LispsmOptions::default())?;
+/// let t = body.tsm(&TsmOptions::default())?;
+/// assert!(l.n.is_finite() && t.eta.is_finite());
+/// # Ok::<(), shadowmap_warp::WarpError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct FocusBody {
+    pub(crate) view: View,
+    pub(crate) focus: Focus,
+}
+
+impl FocusBody {
+    /// The focus body of a camera's whole frustum.
+    ///
+    /// # Errors
+    /// [`WarpError::Frustum`] for an invalid camera; [`WarpError::NonFinite`],
+    /// [`WarpError::ZeroDirection`] for the light; [`WarpError::EmptyReceivers`],
+    /// [`WarpError::EmptyCasters`] for inverted boxes;
+    /// [`WarpError::NoVisibleReceivers`] when the receivers miss the frustum.
+    pub fn new(
+        camera: &Camera,
+        light_direction: Vec3,
+        scene: &FocusScene,
+    ) -> Result<Self, WarpError> {
+        let view = View::camera(camera)?;
+        let focus = focus(&view, light_direction, scene)?;
+        Ok(Self { view, focus })
+    }
+
+    /// The focus body of the slice of a camera's frustum between view depths
+    /// `near < far` (one cascade).
+    ///
+    /// # Errors
+    /// As [`FocusBody::new`], and [`WarpError::Frustum`] for a slice outside the
+    /// camera's depth range.
+    pub fn slice(
+        camera: &Camera,
+        near: f32,
+        far: f32,
+        light_direction: Vec3,
+        scene: &FocusScene,
+    ) -> Result<Self, WarpError> {
+        let view = View::with_frustum(camera, camera.slice(near, far)?)?;
+        let focus = focus(&view, light_direction, scene)?;
+        Ok(Self { view, focus })
+    }
+
+    /// The light frame (rotation only, see [`light_frame`](crate::light_frame)).
+    #[must_use]
+    pub fn light_frame(&self) -> Mat4 {
+        self.focus.rot.as_mat4()
+    }
+
+    /// `sin γ`, `γ` the angle between the viewing and the light direction.
+    #[must_use]
+    pub fn sin_gamma(&self) -> f32 {
+        self.focus.sin_gamma as f32
+    }
+}
+
 /// Largest shadow-map side (texels) whose texels every fit of this crate keeps
 /// resolvable in `f32` (see [`MIN_RELATIVE_EXTENT`]).
 pub const MAX_MAP_SIDE: u32 = 16384;
@@ -274,38 +358,69 @@ fn caster_points(rot: &DMat4, receivers: &Points, caster_box: &Aabb) -> Points {
     for p in receivers {
         b.add(rot.transform_point3(*p));
     }
-    // Planes n.p + d >= 0 in world space.
-    let row = |r: usize| DVec3::new(rot.x_axis[r], rot.y_axis[r], rot.z_axis[r]);
     let (lo, hi) = (caster_box.min.as_dvec3(), caster_box.max.as_dvec3());
-    let planes: [(DVec3, f64); 10] = [
-        (DVec3::X, -lo.x),
-        (DVec3::NEG_X, hi.x),
-        (DVec3::Y, -lo.y),
-        (DVec3::NEG_Y, hi.y),
-        (DVec3::Z, -lo.z),
-        (DVec3::NEG_Z, hi.z),
-        (row(0), -b.min.x),
-        (-row(0), b.max.x),
-        (row(1), -b.min.y),
-        (-row(1), b.max.y),
-    ];
     let scale = lo
         .abs()
         .max(hi.abs())
         .max_element()
         .max(scale_of(receivers));
     let tol = 1e-9 * scale;
+    // Light-space x and y of a world point (rows of the rotation).
+    let row = |r: usize| DVec3::new(rot.x_axis[r], rot.y_axis[r], rot.z_axis[r]);
+    let (rx, ry, rz) = (row(0), row(1), row(2));
+    let in_prism = |p: DVec3| {
+        let (x, y) = (rx.dot(p), ry.dot(p));
+        x >= b.min.x - tol && x <= b.max.x + tol && y >= b.min.y - tol && y <= b.max.y + tol
+    };
+    let in_box =
+        |p: DVec3| p.cmpge(lo - DVec3::splat(tol)).all() && p.cmple(hi + DVec3::splat(tol)).all();
     let mut cands: ArrayVec<DVec3, 128> = ArrayVec::new();
-    for i in 0..10 {
-        for j in i + 1..10 {
-            for k in j + 1..10 {
-                let m = glam::DMat3::from_cols(planes[i].0, planes[j].0, planes[k].0).transpose();
-                let det = m.determinant();
-                if det.abs() < 1e-9 {
-                    continue;
+    // The vertices of box ∩ prism: box corners inside the prism, box edges crossing
+    // a side of the prism, and the prism's four edges (lines along the light)
+    // crossing a face of the box.
+    let corner = |i: usize| {
+        DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    for i in 0..8 {
+        let p = corner(i);
+        if in_prism(p) {
+            let _ = cands.try_push(p);
+        }
+        for bit in [1usize, 2, 4] {
+            if i & bit != 0 {
+                continue;
+            }
+            let q = corner(i | bit);
+            for (axis, value) in [(rx, b.min.x), (rx, b.max.x), (ry, b.min.y), (ry, b.max.y)] {
+                let (a, c) = (axis.dot(p), axis.dot(q));
+                if (a - value) * (c - value) < 0.0 {
+                    let x = p + (q - p) * ((value - a) / (c - a));
+                    if in_prism(x) {
+                        let _ = cands.try_push(x);
+                    }
                 }
-                let p = m.inverse() * DVec3::new(-planes[i].1, -planes[j].1, -planes[k].1);
-                if p.is_finite() && planes.iter().all(|(n, d)| n.dot(p) + d >= -tol) {
+            }
+        }
+    }
+    for (x, y) in [
+        (b.min.x, b.min.y),
+        (b.max.x, b.min.y),
+        (b.min.x, b.max.y),
+        (b.max.x, b.max.y),
+    ] {
+        // World line rx * x + ry * y + rz * t (the rows are orthonormal).
+        let base = rx * x + ry * y;
+        for axis in 0..3 {
+            if rz[axis].abs() < 1e-12 {
+                continue;
+            }
+            for value in [lo[axis], hi[axis]] {
+                let p = base + rz * ((value - base[axis]) / rz[axis]);
+                if p.is_finite() && in_box(p) {
                     let _ = cands.try_push(p);
                 }
             }
@@ -313,7 +428,7 @@ fn caster_points(rot: &DMat4, receivers: &Points, caster_box: &Aabb) -> Points {
     }
     // Keep the candidates that matter for the depth range: the highest toward the
     // light (all of them when they fit).
-    let z_of = |p: &DVec3| rot.transform_point3(*p).z;
+    let z_of = |p: &DVec3| rz.dot(*p);
     for p in &cands {
         if out.try_push(*p).is_err() {
             // Full: replace the lowest point if this one is higher.

@@ -143,7 +143,7 @@ mod xpsm;
 
 pub use cascades::{WarpedCascade, WarpedCascades, warped_cascades};
 pub use error::WarpError;
-pub use focus::{FocusScene, MAX_MAP_SIDE, MIN_RELATIVE_EXTENT};
+pub use focus::{FocusBody, FocusScene, MAX_MAP_SIDE, MIN_RELATIVE_EXTENT};
 pub use lispsm::{
     LispsmOptions, LispsmShadow, MAX_WARP_RATIO, UniformOptions, lispsm, uniform_focused,
 };
@@ -167,8 +167,7 @@ use shadowmap_frustum::Camera;
 /// # Errors
 /// [`WarpError::Frustum`], [`WarpError::NonFinite`], [`WarpError::ZeroDirection`].
 pub fn light_frame(camera: &Camera, light_direction: Vec3) -> Result<Mat4, WarpError> {
-    camera.validate()?;
-    let view = focus::View::with_frustum(camera, camera.frustum()?)?;
+    let view = focus::View::camera(camera)?;
     let light = focus::light_unit(light_direction)?;
     Ok(focus::frame(light, view.forward, view.up).0.as_mat4())
 }

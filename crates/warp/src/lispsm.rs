@@ -5,7 +5,7 @@ use shadowmap_frustum::{Camera, ShadowTransform, math};
 
 use crate::WarpError;
 use crate::focus::{
-    Bounds, Focus, FocusScene, View, finish, focus, footprint_weight, ortho_fit, scale_of,
+    Bounds, Focus, FocusBody, FocusScene, View, finish, footprint_weight, ortho_fit, scale_of,
     smoothstep, sqrt0, transform_points,
 };
 
@@ -169,9 +169,7 @@ pub fn uniform_focused(
     scene: &FocusScene,
     options: &UniformOptions,
 ) -> Result<ShadowTransform, WarpError> {
-    let view = View::camera(camera)?;
-    let f = focus(&view, light_direction, scene)?;
-    warp_fit(&f, &view, 0.0, options.reversed_z).map(|(t, _)| t)
+    FocusBody::new(camera, light_direction, scene)?.uniform(options)
 }
 
 /// Light space perspective shadow map (Wimmer, Scherzer and Purgathofer 2004) with the
@@ -186,28 +184,36 @@ pub fn lispsm(
     options: &LispsmOptions,
 ) -> Result<LispsmShadow, WarpError> {
     options.check()?;
-    let view = View::camera(camera)?;
-    lispsm_view(&view, light_direction, scene, options)
+    FocusBody::new(camera, light_direction, scene)?.lispsm(options)
 }
 
-pub(crate) fn lispsm_view(
-    view: &View,
-    light_direction: Vec3,
-    scene: &FocusScene,
-    options: &LispsmOptions,
-) -> Result<LispsmShadow, WarpError> {
-    let f = focus(view, light_direction, scene)?;
-    let (s, fade) = warp_strength(&f, view, options);
-    let (transform, s) = warp_fit(&f, view, s, options.reversed_z)?;
-    Ok(LispsmShadow {
-        transform,
-        n: if s > 0.0 {
-            (1.0 / s) as f32
-        } else {
-            f32::INFINITY
-        },
-        fade: fade as f32,
-    })
+impl FocusBody {
+    /// The uniform focused fit of this body (see [`uniform_focused`]).
+    ///
+    /// # Errors
+    /// [`WarpError::Degenerate`] when the `f32` result would be singular.
+    pub fn uniform(&self, options: &UniformOptions) -> Result<ShadowTransform, WarpError> {
+        warp_fit(&self.focus, &self.view, 0.0, options.reversed_z).map(|(t, _)| t)
+    }
+
+    /// The LiSPSM fit of this body (see [`lispsm`]).
+    ///
+    /// # Errors
+    /// [`WarpError::InvalidOption`]; [`WarpError::Degenerate`].
+    pub fn lispsm(&self, options: &LispsmOptions) -> Result<LispsmShadow, WarpError> {
+        options.check()?;
+        let (s, fade) = warp_strength(&self.focus, &self.view, options);
+        let (transform, s) = warp_fit(&self.focus, &self.view, s, options.reversed_z)?;
+        Ok(LispsmShadow {
+            transform,
+            n: if s > 0.0 {
+                (1.0 / s) as f32
+            } else {
+                f32::INFINITY
+            },
+            fade: fade as f32,
+        })
+    }
 }
 
 /// The warp strength `s = 1/n` and the fade weight.

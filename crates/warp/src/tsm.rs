@@ -4,7 +4,8 @@ use arrayvec::ArrayVec;
 use glam::Vec3;
 use shadowmap_frustum::{Camera, MAX_BODY_VERTICES, ShadowTransform, math};
 
-use crate::focus::{FocusScene, View, focus, smoothstep};
+use crate::FocusBody;
+use crate::focus::{Focus, FocusScene, View, smoothstep};
 use crate::lispsm::warp_fit;
 use crate::{MAX_WARP_RATIO, WarpError};
 
@@ -124,8 +125,21 @@ pub fn tsm(
     options: &TsmOptions,
 ) -> Result<TsmShadow, WarpError> {
     options.check()?;
-    let view = View::camera(camera)?;
-    let f = focus(&view, light_direction, scene)?;
+    FocusBody::new(camera, light_direction, scene)?.tsm(options)
+}
+
+impl FocusBody {
+    /// The TSM fit of this body (see [`tsm`]).
+    ///
+    /// # Errors
+    /// [`WarpError::InvalidOption`]; [`WarpError::Degenerate`].
+    pub fn tsm(&self, options: &TsmOptions) -> Result<TsmShadow, WarpError> {
+        options.check()?;
+        tsm_body(&self.view, &self.focus, options)
+    }
+}
+
+fn tsm_body(view: &View, f: &Focus, options: &TsmOptions) -> Result<TsmShadow, WarpError> {
     let deg = core::f64::consts::PI / 180.0;
     let fade = smoothstep(
         math::sin(f64::from(options.fade_end_deg) * deg),
@@ -162,7 +176,7 @@ pub fn tsm(
         s = s.min((MAX_WARP_RATIO - 1.0) / lambda);
     }
     let s = if s.is_finite() { s * fade } else { 0.0 };
-    let (transform, s) = warp_fit(&f, &view, s, options.reversed_z)?;
+    let (transform, s) = warp_fit(f, view, s, options.reversed_z)?;
     Ok(TsmShadow {
         transform,
         eta: if s > 0.0 {

@@ -4,8 +4,9 @@ use arrayvec::ArrayVec;
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap_frustum::{Camera, ShadowTransform};
 
+use crate::FocusBody;
 use crate::WarpError;
-use crate::focus::{Bounds, View, finish, focus, footprint_weight, scale_of, smoothstep};
+use crate::focus::{Bounds, Focus, View, finish, footprint_weight, scale_of, smoothstep};
 
 /// Options of [`xpsm`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -204,8 +205,23 @@ pub fn xpsm(
     options: &XpsmOptions,
 ) -> Result<XpsmShadow, WarpError> {
     options.validate()?;
-    let view = View::camera(camera)?;
-    let f = focus(&view, light_direction, scene)?;
+    FocusBody::new(camera, light_direction, scene)?.xpsm(options)
+}
+
+impl FocusBody {
+    /// The XPSM fit of this body (see [`xpsm`]).
+    ///
+    /// # Errors
+    /// [`WarpError::InvalidOption`]; [`WarpError::EmptyFocusRegion`];
+    /// [`WarpError::Degenerate`].
+    pub fn xpsm(&self, options: &XpsmOptions) -> Result<XpsmShadow, WarpError> {
+        options.validate()?;
+        xpsm_body(&self.view, &self.focus, options)
+    }
+}
+
+fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow, WarpError> {
+    let view = *view;
     let eps_w = f64::from(options.epsilon_w);
 
     // Step 1: light space, origin at the viewer, light along -Z.
@@ -251,7 +267,7 @@ pub fn xpsm(
     let mut length_p = match options.coef {
         Some(c) if weight > 0.0 => weight * f64::from(c) / v_xy,
         Some(_) => 0.0,
-        None => auto_length(&f, &view, weight),
+        None => auto_length(f, &view, weight),
     };
     // Step 7: clip against the back-projection singularity.
     if max_length_p > 0.0 && length_p > max_length_p {
