@@ -19,9 +19,10 @@ pub struct XpsmOptions {
     /// critical case (casters behind the viewer). Default 0.1.
     pub epsilon_w: f32,
     /// `coef` of the paper (inverse world units): warping `1 / (coef d + 1)` at view
-    /// distance `d`, `lengthP = coef / cos γ`. `None` (default) picks the projection
-    /// vector whose warp equals LiSPSM's `n_opt` warp (same projection centre), faded
-    /// out with the miner's-lamp weight.
+    /// distance `d`, `lengthP = coef / cos γ`. `None` (default) uses
+    /// `coef = 1 / sqrt(z_n z_f)` from the visible receivers and keeps the warp
+    /// ratio it means over the visible region wherever that region lies (see
+    /// [`xpsm`], step 6).
     pub coef: Option<f32>,
     /// `|V_xy|` (the sine of the angle between view and light) below which the
     /// miner's-lamp case applies: orthographic shadows with focusing. The paper
@@ -142,7 +143,8 @@ type Cloud = ArrayVec<Hom, 1100>;
 /// receivers; casters the corners of the caster box.
 ///
 /// 1. Light space: the shared light frame ([`light_frame`](crate::light_frame)) with
-///    its origin at the viewer.
+///    its origin at the viewer (for the automatic length of step 6, moved along
+///    `unit P` to the near face of the focus body).
 /// 2. The view vector in light space, `V`.
 /// 3. `unit P = V_xy / |V_xy|`, which is the frame's `+Y` whenever `V_xy` is not tiny
 ///    (in the near-parallel band the frame turns continuously toward the camera's
@@ -154,10 +156,14 @@ type Cloud = ArrayVec<Hom, 1100>;
 /// 5. `maxLengthP = (epsilonW - 1) / max(minCastersProj, minReceiversProj)` when the
 ///    focus interval starts behind the viewer (no bound otherwise).
 /// 6. `lengthP = coef / cos γ`, `cos γ = |V_xy|`, for a given
-///    [`XpsmOptions::coef`]; by default the length whose warp has LiSPSM's `n_opt`
-///    projection centre (`lengthP = s / (1 + s (y_eye - y_0))`, `s = 1 / n_opt`,
-///    `y_0` the near face of the focus body on the warp axis), since the paper's
-///    fixed `coef` over-warps as the light turns toward the view.
+///    [`XpsmOptions::coef`]. By default the warp ratio the paper's
+///    `coef = 1 / sqrt(z_n z_f)` means over the visible depth range,
+///    `1 + coef (z_f - z_n)`, is spread over the receivers' extent `D` along
+///    `unit P`, `lengthP = coef (z_f - z_n) / D`, and the origin of step 1 moves
+///    along `unit P` from the viewer to the near face of the focus body. This equals
+///    the paper's length and origin when the visible region starts at the viewer
+///    and its extent is the depth range times `cos γ`; a camera looking down or
+///    toward the light breaks both, and the paper's length then over-warps.
 /// 7. Clip: `lengthP = min(lengthP, maxLengthP)` when `maxLengthP > 0`. Then two
 ///    precision guards: `1 + lengthP * maxProj <= MAX_WARP_RATIO` and
 ///    `lengthP <= MAX_WARP_RATIO / L` ([`MAX_WARP_RATIO`](crate::MAX_WARP_RATIO)).
@@ -224,14 +230,23 @@ fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow
     let view = *view;
     let eps_w = f64::from(options.epsilon_w);
 
-    // Step 1: light space, origin at the viewer, light along -Z.
-    let light_space = f.rot * DMat4::from_translation(-view.eye);
     // Steps 2-3: view vector in light space and its xy direction. The shared light
     // frame has +Y along V_xy whenever V_xy is not tiny, so unit P = (0, 1); in the
     // near-parallel band the frame follows the camera's up vector continuously.
     let v_xy = f.sin_gamma;
     let thr = f64::from(options.miner_lamp_threshold);
     let weight = smoothstep(thr, 2.0 * thr, v_xy);
+    // Step 6 (first, since the automatic length places the origin): optimal length.
+    let (mut length_p, shift) = match options.coef {
+        Some(c) if weight > 0.0 => (weight * f64::from(c) / v_xy, 0.0),
+        Some(_) => (0.0, 0.0),
+        None => auto_length(f, &view, weight),
+    };
+    // Step 1: light space, origin at the viewer (moved along unit P by `shift` for
+    // the automatic length), light along -Z.
+    let light_space = DMat4::from_translation(DVec3::new(0.0, -shift, 0.0))
+        * f.rot
+        * DMat4::from_translation(-view.eye);
     let unit_p = glam::DVec2::Y;
 
     let receivers: ArrayVec<DVec3, 64> = f
@@ -262,12 +277,6 @@ fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow
         (eps_w - 1.0) / min_focus
     } else {
         f64::INFINITY
-    };
-    // Step 6: optimal length.
-    let mut length_p = match options.coef {
-        Some(c) if weight > 0.0 => weight * f64::from(c) / v_xy,
-        Some(_) => 0.0,
-        None => auto_length(f, &view, weight),
     };
     // Step 7: clip against the back-projection singularity.
     if max_length_p > 0.0 && length_p > max_length_p {
@@ -390,29 +399,49 @@ fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow
     })
 }
 
-/// The automatic `lengthP`: the projection vector whose warp equals LiSPSM's at
-/// `eta = 0` (`n_opt`), faded by `weight`.
+/// The automatic `lengthP`, faded by `weight`.
 ///
-/// LiSPSM's warp is `w ∝ 1 + s (y - y_0)` (`y_0` the near face of the body on the
-/// warp axis), XPSM's `w = 1 + lengthP p`, `p = y - y_eye`; they have the same
-/// projection centre, hence the same map after the focus fit, when
-/// `lengthP = s / (1 + s (y_eye - y_0))`. The paper's `coef / cos γ` with a fixed
-/// `coef` grows as the light turns toward the view (`1 / sin γ` here) and puts the
-/// centre relative to the viewer, not to the visible region: with the light near the
-/// view (a camera looking down, a low sun ahead) the visible region reaches far
-/// behind the viewer along the warp axis and the clip of step 7 then drives the warp
-/// to its `epsilonW` limit, which magnifies one edge of the map and starves the rest.
-/// When the centre would lie beyond the viewer (`1 + s (y_eye - y_0) <= 0`) the
-/// length is left unbounded here and clipped by step 7 and the precision guards.
-fn auto_length(f: &crate::focus::Focus, view: &View, weight: f64) -> f64 {
-    let s = crate::lispsm::strength(f, view, 0.0, (0.0, f64::INFINITY), weight);
-    if !(s > 0.0) {
-        return 0.0;
+/// The paper warps by `w = 1 + coef d` at view distance `d`, `coef = 1 / sqrt(z_n z_f)`
+/// over the visible receivers, so the warp ratio across the visible depth range is
+/// `1 + coef (z_f - z_n)`; its `lengthP = coef / cos γ` reaches that ratio only when
+/// the light-space extent of the visible region along `unit P` is the depth range
+/// times `cos γ` (the paper's `γ`, here `sin γ`) and the region starts at the
+/// viewer. Neither holds when the light is near the view (a camera looking down, a
+/// low sun ahead): the region spreads sideways and reaches behind the viewer, and
+/// the paper's length then over-warps it, and the back-projection clip of step 7
+/// drives one edge to `epsilonW` (ten times magnified, the rest starved). So the
+/// ratio is kept, and placed on the region: `lengthP = coef (z_f - z_n) / D`, `D`
+/// the receivers' extent along `unit P`, with the light-space origin moved along
+/// `unit P` from the viewer to the near face `y_0` of the focus body (the returned
+/// shift `y_0 - y_eye`), so the projection centre lies `1 / lengthP` before the
+/// region wherever the viewer is. In the paper's own setting
+/// (`D = (z_f - z_n) cos γ`, region starting at the viewer) this is its
+/// `coef / cos γ` with its origin. Returns `(lengthP, shift)`.
+fn auto_length(f: &Focus, view: &View, weight: f64) -> (f64, f64) {
+    if !(weight > 0.0) {
+        return (0.0, 0.0);
+    }
+    let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
+    let (mut r0, mut r1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in &f.receivers {
+        let d = (*p - view.eye).dot(view.forward);
+        z_n = z_n.min(d);
+        z_f = z_f.max(d);
+        let y = f.rot.transform_point3(*p).y;
+        r0 = r0.min(y);
+        r1 = r1.max(y);
+    }
+    let z_scale = z_f.abs().max(z_n.abs()).max(f64::MIN_POSITIVE);
+    let z_n = z_n.max(1e-6 * z_scale);
+    let z_f = z_f.max(z_n);
+    let coef = 1.0 / crate::focus::sqrt0(z_n * z_f);
+    let s = weight * coef * (z_f - z_n) / (r1 - r0);
+    if !(s.is_finite() && s > 0.0) {
+        return (0.0, 0.0);
     }
     let (y0, _) = f.warp_axis_range();
     let y_eye = f.rot.transform_point3(view.eye).y;
-    let k = 1.0 + s * (y_eye - y0);
-    if k > 1e-9 { s / k } else { f64::INFINITY }
+    (s, y0 - y_eye)
 }
 
 /// PPLS points of a vertex set, split by the plane `w = eps_w`: every vertex (those

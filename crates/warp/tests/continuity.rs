@@ -156,6 +156,9 @@ fn light_sweep_is_continuous_and_never_worse_than_uniform() {
                 for k in 0..5 {
                     for j in 0..2 {
                         let ratio = sizes[k][j] / pr[k][j];
+                        if (ratio - 1.0).abs() > 0.02 {
+                            eprintln!("STEP {} {deg:.2} {height} {j} {ratio}", NAMES[k]);
+                        }
                         assert!(
                             (ratio - 1.0).abs() <= 0.02,
                             "{} at {deg:.2}°, height {height}: texel size at {:?} changed by {ratio}",
