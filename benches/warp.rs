@@ -1,12 +1,13 @@
 //! Per-frame cost of the `shadowmap-warp` builders (uniform focused, LiSPSM, XPSM,
-//! TSM, four warped cascades), each also reported as a ratio to the uniform-focused fit
-//! timed in the same run.
+//! TSM, four warped cascades, and all four single-frustum fits from one shared
+//! `FocusBody`), each also reported as a ratio to the uniform-focused fit timed in the
+//! same run.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use shadowmap::frustum::{Aabb, Camera, CascadeSplits, Projection, SplitScheme};
 use shadowmap::warp::{
-    FocusScene, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
+    FocusBody, FocusScene, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
     uniform_focused, warped_cascades, xpsm,
 };
 use std::hint::black_box;
@@ -91,7 +92,14 @@ fn run(s: &Setup, which: usize) {
                 .unwrap(),
             );
         }
-        _ => {
+        5 => {
+            let body = FocusBody::new(black_box(&s.camera), black_box(s.light), &s.scene).unwrap();
+            black_box(body.uniform(&UniformOptions::default()).unwrap());
+            black_box(body.lispsm(&LispsmOptions::default()).unwrap());
+            black_box(body.xpsm(&XpsmOptions::default()).unwrap());
+            black_box(body.tsm(&TsmOptions::default()).unwrap());
+        }
+        4 => {
             black_box(
                 warped_cascades(
                     black_box(&s.camera),
@@ -104,15 +112,17 @@ fn run(s: &Setup, which: usize) {
                 .unwrap(),
             );
         }
+        _ => unreachable!("no bench {which}"),
     }
 }
 
-const NAMES: [&str; 5] = [
+const NAMES: [&str; 6] = [
     "uniform_focused",
     "lispsm",
     "xpsm",
     "tsm",
     "warped_cascades_4",
+    "focus_body_then_all_four",
 ];
 
 fn warp(c: &mut Criterion) {

@@ -4,9 +4,7 @@ use arrayvec::ArrayVec;
 use glam::Vec3;
 use shadowmap_frustum::{Camera, CascadeSplits, MAX_CASCADES};
 
-use crate::focus::View;
-use crate::lispsm::lispsm_view;
-use crate::{FocusScene, LispsmOptions, LispsmShadow, WarpError};
+use crate::{FocusBody, FocusScene, LispsmOptions, LispsmShadow, WarpError};
 
 /// One cascade of a warped-cascade fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,8 +55,9 @@ pub fn warped_cascades(
         let (near, far) = splits.cascade_range(i).ok_or(WarpError::InvalidCascades)?;
         let opts = options.with_eta(*eta);
         opts.check()?;
-        let view = View::with_frustum(camera, camera.slice(near, far)?)?;
-        let shadow = match lispsm_view(&view, light_direction, scene, &opts) {
+        let shadow = match FocusBody::slice(camera, near, far, light_direction, scene)
+            .and_then(|body| body.lispsm(&opts))
+        {
             Ok(s) => {
                 any = true;
                 Some(s)

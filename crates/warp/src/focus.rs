@@ -39,11 +39,14 @@ impl FocusScene {
     }
 }
 
-/// `sin` of the angle between view and light below which the light frame starts to
-/// lean on the camera's up vector (see [`light_frame`](crate::light_frame)).
-pub(crate) const FRAME_BLEND_HI: f64 = 0.173_648_177_666_930_35; // sin 10°
-/// `sin` of the angle below which the light frame follows the camera's up vector only.
-pub(crate) const FRAME_BLEND_LO: f64 = 0.034_899_496_702_500_97; // sin 2°
+/// Amplitude of the camera-up term of the light frame (`sin 1°`), used while the
+/// light is within 1 degree of the viewing direction (see [`frame`]).
+pub(crate) const FRAME_UP_WEIGHT: f64 = 0.017_452_406_437_283_51; // sin 1°
+/// `sin` of the angle where the camera-up term starts to fade out (1 degree).
+pub(crate) const FRAME_BLEND_LO: f64 = 0.017_452_406_437_283_51; // sin 1°
+/// `sin` of the angle above which the light frame follows the view direction only
+/// (3 degrees, the default end of every warp's parallel-light fade).
+pub(crate) const FRAME_BLEND_HI: f64 = 0.052_335_956_242_943_83; // sin 3°
 
 /// Cubic smoothstep of `x` between `lo < hi`.
 pub(crate) fn smoothstep(lo: f64, hi: f64, x: f64) -> f64 {
@@ -104,20 +107,40 @@ pub(crate) fn light_unit(direction: Vec3) -> Result<DVec3, WarpError> {
 }
 
 /// The light frame shared by every technique: rotation only, light looking down `-Z`,
-/// `+Y` the warp axis (the view direction made perpendicular to the light, blended
-/// toward the camera's up vector as the light turns parallel to the view).
+/// `+Y` the warp axis.
 ///
 /// Returns the rotation and `sin γ`, `γ` the angle between view and light direction.
+///
+/// With `g` the view direction made perpendicular to the light (`|g| = sin γ`) and
+/// `u` the camera's up vector made perpendicular to the light, the warp axis is
+///
+/// ```text
+/// a = g + c(|g|) u,   c(x) = sin 1° · (1 - smoothstep(sin 1°, sin 3°, x))
+/// ```
+///
+/// Why this form: a warp must push texels toward the viewer, so its axis must agree
+/// in sign with `g` wherever the warp has strength; and the frame must turn
+/// continuously with the light. `a · g = |g|² + c (u · g) ≥ |g| (|g| - c(|g|))`, and
+/// since `c` decreases, `a · g > 0` and `a ≠ 0` for every `|g| > g*`, `g*` the one
+/// solution of `c(g*) = g*` (`g* = sin 1°`). Above 3 degrees `a = g` exactly.
+/// No tangent field on the sphere of light directions is free of zeros (the
+/// hairy-ball theorem); this one vanishes only at the two light directions `g*` from
+/// the view axis (and from its opposite) on the side of `-u`, where every warp of
+/// this crate has faded to the uniform fit with its default options (LiSPSM and TSM
+/// fade below 3 degrees, XPSM below about 5.7). Near those two points, and only
+/// there, the uniform fit turns fast about the light axis. (A blend that gives the
+/// up term full weight far from the view axis cancels where the warps are strong,
+/// and points the warp backward on one side of that point.)
 pub(crate) fn frame(light: DVec3, forward: DVec3, cam_up: DVec3) -> (DMat4, f64) {
     let v_perp = forward - light * forward.dot(light);
     let sin_g = v_perp.length().min(1.0);
     let u_perp = cam_up - light * cam_up.dot(light);
-    let c = 1.0 - smoothstep(FRAME_BLEND_LO, FRAME_BLEND_HI, sin_g);
-    let mut up = v_perp + u_perp * c;
+    let c = FRAME_UP_WEIGHT * (1.0 - smoothstep(FRAME_BLEND_LO, FRAME_BLEND_HI, sin_g));
+    let mut up = v_perp + u_perp.normalize_or_zero() * c;
     up -= light * up.dot(light);
     let up = up.try_normalize().unwrap_or_else(|| {
-        // Only on the (measure-zero) directions where the blend cancels: any axis
-        // perpendicular to the light keeps the frame valid.
+        // Only on the two (measure-zero) directions where the blend cancels: any
+        // axis perpendicular to the light keeps the frame valid.
         light.any_orthonormal_vector()
     });
     let z = -light;
@@ -166,6 +189,19 @@ pub(crate) struct Focus {
     pub(crate) caster_box: Aabb,
 }
 
+impl Focus {
+    /// Smallest and largest light-space `y` (the warp axis) of the caster body.
+    pub(crate) fn warp_axis_range(&self) -> (f64, f64) {
+        let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
+        for p in &self.casters {
+            let y = self.rot.transform_point3(*p).y;
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+        (y0, y1)
+    }
+}
+
 pub(crate) fn focus(view: &View, light: Vec3, scene: &FocusScene) -> Result<Focus, WarpError> {
     let dir = light_unit(light)?;
     let (receivers, casters) = check_scene(scene)?;
@@ -186,10 +222,127 @@ pub(crate) fn focus(view: &View, light: Vec3, scene: &FocusScene) -> Result<Focu
     })
 }
 
-/// Smallest extent of a focus region, relative to the largest world coordinate of the
-/// focus body: thinner regions (a point or a flat sheet of receivers seen edge-on)
-/// are widened to it, so `f32` matrices stay well conditioned.
-pub const MIN_RELATIVE_EXTENT: f64 = 1e-5;
+/// The first stage of every technique, built once per frame and shared: the checked
+/// camera (or one slice of it), light and scene, the light frame
+/// ([`light_frame`](crate::light_frame)) and the focus body (frustum ∩ receivers,
+/// and the casters that can shadow it).
+///
+/// Build it with [`FocusBody::new`], then fit any number of techniques from it
+/// ([`FocusBody::uniform`], [`FocusBody::lispsm`], [`FocusBody::xpsm`],
+/// [`FocusBody::tsm`]) without repeating the validation, the clipping or the frame.
+/// The free functions ([`uniform_focused`](crate::uniform_focused),
+/// [`lispsm`](crate::lispsm), ...) build one and call these.
+///
+/// ```
+/// use glam::Vec3;
+/// use shadowmap_frustum::{Aabb, Camera, Projection};
+/// use shadowmap_warp::{FocusBody, FocusScene, LispsmOptions, TsmOptions};
+///
+/// let camera = Camera::look_to(
+///     Vec3::new(0.0, 2.0, 0.0),
+///     Vec3::NEG_Z,
+///     Vec3::Y,
+///     Projection::perspective(1.0, 1.5, 0.5, 100.0),
+/// )?;
+/// let scene = FocusScene::whole(Aabb::new(Vec3::splat(-50.0), Vec3::splat(50.0)));
+/// let body = FocusBody::new(&camera, Vec3::new(0.3, -1.0, -0.2), &scene)?;
+/// let l = body.lispsm(&LispsmOptions::default())?;
+/// let t = body.tsm(&TsmOptions::default())?;
+/// assert!(l.n.is_finite() && t.eta.is_finite());
+/// # Ok::<(), shadowmap_warp::WarpError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct FocusBody {
+    pub(crate) view: View,
+    pub(crate) focus: Focus,
+}
+
+impl FocusBody {
+    /// The focus body of a camera's whole frustum.
+    ///
+    /// # Errors
+    /// [`WarpError::Frustum`] for an invalid camera; [`WarpError::NonFinite`],
+    /// [`WarpError::ZeroDirection`] for the light; [`WarpError::EmptyReceivers`],
+    /// [`WarpError::EmptyCasters`] for inverted boxes;
+    /// [`WarpError::NoVisibleReceivers`] when the receivers miss the frustum.
+    pub fn new(
+        camera: &Camera,
+        light_direction: Vec3,
+        scene: &FocusScene,
+    ) -> Result<Self, WarpError> {
+        let view = View::camera(camera)?;
+        let focus = focus(&view, light_direction, scene)?;
+        Ok(Self { view, focus })
+    }
+
+    /// The focus body of the slice of a camera's frustum between view depths
+    /// `near < far` (one cascade).
+    ///
+    /// # Errors
+    /// As [`FocusBody::new`], and [`WarpError::Frustum`] for a slice outside the
+    /// camera's depth range.
+    pub fn slice(
+        camera: &Camera,
+        near: f32,
+        far: f32,
+        light_direction: Vec3,
+        scene: &FocusScene,
+    ) -> Result<Self, WarpError> {
+        let view = View::with_frustum(camera, camera.slice(near, far)?)?;
+        let focus = focus(&view, light_direction, scene)?;
+        Ok(Self { view, focus })
+    }
+
+    /// The light frame (rotation only, see [`light_frame`](crate::light_frame)).
+    #[must_use]
+    pub fn light_frame(&self) -> Mat4 {
+        self.focus.rot.as_mat4()
+    }
+
+    /// `sin γ`, `γ` the angle between the viewing and the light direction.
+    #[must_use]
+    pub fn sin_gamma(&self) -> f32 {
+        self.focus.sin_gamma as f32
+    }
+}
+
+/// Largest shadow-map side (texels) whose texels every fit of this crate keeps
+/// resolvable in `f32` (see [`MIN_RELATIVE_EXTENT`]).
+pub const MAX_MAP_SIDE: u32 = 16384;
+
+/// Smallest extent of a focus region across the light (light-space `x` and `y`),
+/// relative to `L`, the largest world coordinate of the focus body: `2^-7`.
+///
+/// A shader evaluates `uv_from_world` in `f32` at world coordinates of magnitude `L`,
+/// with a rounding error of about 4 ulps, `4 · 2^-24 L` in world units. For that to
+/// stay within half a texel of a [`MAX_MAP_SIDE`] (`2^14`) map, a texel must be at
+/// least `8 · 2^-24 L` wide, so the region at least `2^14 · 8 · 2^-24 L = 2^-7 L`.
+/// Thinner regions (a point receiver, a tiny scene far from the origin, a flat sheet
+/// of receivers seen edge-on) get the uniform fit, widened about their centre to
+/// this extent: at 2048² and `L = 1000`, a point receiver's map covers 7.8 world
+/// units. Between four times and once this extent the warp fades out and the widening
+/// fades in, so nothing pops. Render camera-relative to shrink `L`.
+pub const MIN_RELATIVE_EXTENT: f64 = 0.007_812_5;
+
+/// Smallest extent of the other axes of a fit (depth, and warped coordinates),
+/// relative to `L`: enough for `f32` matrices to stay invertible.
+const MIN_PAD_EXTENT: f64 = 1e-5;
+
+/// How far the light-space footprint (`x`, `y`) of `points` is from thin, in
+/// `[0, 1]`: 0 when its smaller side is at most [`MIN_RELATIVE_EXTENT`] times
+/// `scale`, 1 from four times that, smooth between. Fits scale their warp by it and widen
+/// the footprint by `1 -` it, so a region that thins out turns continuously into the
+/// widened uniform fit.
+pub(crate) fn footprint_weight(rot: &DMat4, points: &[DVec3], scale: f64) -> f64 {
+    let mut b = Bounds::EMPTY;
+    for p in points {
+        b.add(rot.transform_point3(*p));
+    }
+    let ext = b.max - b.min;
+    let min = MIN_RELATIVE_EXTENT * scale;
+    let t = smoothstep(1.0, 4.0, ext.x.min(ext.y) / min);
+    if t.is_finite() { t } else { 0.0 }
+}
 
 /// The receivers' vertices plus the vertices of `caster box ∩ prism`, the prism being
 /// the receivers' light-space xy bounds extended along the light: every caster point
@@ -205,38 +358,69 @@ fn caster_points(rot: &DMat4, receivers: &Points, caster_box: &Aabb) -> Points {
     for p in receivers {
         b.add(rot.transform_point3(*p));
     }
-    // Planes n.p + d >= 0 in world space.
-    let row = |r: usize| DVec3::new(rot.x_axis[r], rot.y_axis[r], rot.z_axis[r]);
     let (lo, hi) = (caster_box.min.as_dvec3(), caster_box.max.as_dvec3());
-    let planes: [(DVec3, f64); 10] = [
-        (DVec3::X, -lo.x),
-        (DVec3::NEG_X, hi.x),
-        (DVec3::Y, -lo.y),
-        (DVec3::NEG_Y, hi.y),
-        (DVec3::Z, -lo.z),
-        (DVec3::NEG_Z, hi.z),
-        (row(0), -b.min.x),
-        (-row(0), b.max.x),
-        (row(1), -b.min.y),
-        (-row(1), b.max.y),
-    ];
     let scale = lo
         .abs()
         .max(hi.abs())
         .max_element()
         .max(scale_of(receivers));
     let tol = 1e-9 * scale;
+    // Light-space x and y of a world point (rows of the rotation).
+    let row = |r: usize| DVec3::new(rot.x_axis[r], rot.y_axis[r], rot.z_axis[r]);
+    let (rx, ry, rz) = (row(0), row(1), row(2));
+    let in_prism = |p: DVec3| {
+        let (x, y) = (rx.dot(p), ry.dot(p));
+        x >= b.min.x - tol && x <= b.max.x + tol && y >= b.min.y - tol && y <= b.max.y + tol
+    };
+    let in_box =
+        |p: DVec3| p.cmpge(lo - DVec3::splat(tol)).all() && p.cmple(hi + DVec3::splat(tol)).all();
     let mut cands: ArrayVec<DVec3, 128> = ArrayVec::new();
-    for i in 0..10 {
-        for j in i + 1..10 {
-            for k in j + 1..10 {
-                let m = glam::DMat3::from_cols(planes[i].0, planes[j].0, planes[k].0).transpose();
-                let det = m.determinant();
-                if det.abs() < 1e-9 {
-                    continue;
+    // The vertices of box ∩ prism: box corners inside the prism, box edges crossing
+    // a side of the prism, and the prism's four edges (lines along the light)
+    // crossing a face of the box.
+    let corner = |i: usize| {
+        DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    for i in 0..8 {
+        let p = corner(i);
+        if in_prism(p) {
+            let _ = cands.try_push(p);
+        }
+        for bit in [1usize, 2, 4] {
+            if i & bit != 0 {
+                continue;
+            }
+            let q = corner(i | bit);
+            for (axis, value) in [(rx, b.min.x), (rx, b.max.x), (ry, b.min.y), (ry, b.max.y)] {
+                let (a, c) = (axis.dot(p), axis.dot(q));
+                if (a - value) * (c - value) < 0.0 {
+                    let x = p + (q - p) * ((value - a) / (c - a));
+                    if in_prism(x) {
+                        let _ = cands.try_push(x);
+                    }
                 }
-                let p = m.inverse() * DVec3::new(-planes[i].1, -planes[j].1, -planes[k].1);
-                if p.is_finite() && planes.iter().all(|(n, d)| n.dot(p) + d >= -tol) {
+            }
+        }
+    }
+    for (x, y) in [
+        (b.min.x, b.min.y),
+        (b.max.x, b.min.y),
+        (b.min.x, b.max.y),
+        (b.max.x, b.max.y),
+    ] {
+        // World line rx * x + ry * y + rz * t (the rows are orthonormal).
+        let base = rx * x + ry * y;
+        for axis in 0..3 {
+            if rz[axis].abs() < 1e-12 {
+                continue;
+            }
+            for value in [lo[axis], hi[axis]] {
+                let p = base + rz * ((value - base[axis]) / rz[axis]);
+                if p.is_finite() && in_box(p) {
                     let _ = cands.try_push(p);
                 }
             }
@@ -244,7 +428,7 @@ fn caster_points(rot: &DMat4, receivers: &Points, caster_box: &Aabb) -> Points {
     }
     // Keep the candidates that matter for the depth range: the highest toward the
     // light (all of them when they fit).
-    let z_of = |p: &DVec3| rot.transform_point3(*p).z;
+    let z_of = |p: &DVec3| rz.dot(*p);
     for p in &cands {
         if out.try_push(*p).is_err() {
             // Full: replace the lowest point if this one is higher.
@@ -284,12 +468,18 @@ impl Bounds {
         !(self.min.cmple(self.max).all())
     }
 
-    /// Widens thin axes to at least `MIN_RELATIVE_EXTENT * scale` (the documented
-    /// zero-area fallback), and every axis by a relative margin so that rounding keeps
-    /// points inside.
-    pub(crate) fn padded(mut self, scale: f64) -> Self {
-        let min_extent = MIN_RELATIVE_EXTENT * scale;
+    /// Widens thin axes to at least `MIN_PAD_EXTENT * scale` (`x` and `y` to
+    /// `thin * MIN_RELATIVE_EXTENT * scale`, `thin = 1 -` [`footprint_weight`]: the
+    /// documented thin-region fallback), and every axis by a relative margin so that
+    /// rounding keeps points inside.
+    pub(crate) fn padded(mut self, scale: f64, thin: f64) -> Self {
         for axis in 0..3 {
+            let rel = if axis < 2 {
+                (thin * MIN_RELATIVE_EXTENT).max(MIN_PAD_EXTENT)
+            } else {
+                MIN_PAD_EXTENT
+            };
+            let min_extent = rel * scale;
             let (lo, hi) = (self.min[axis], self.max[axis]);
             let ext = hi - lo;
             let pad = if ext < min_extent {
@@ -320,16 +510,24 @@ pub(crate) fn ortho_fit(b: &Bounds, reversed_z: bool) -> DMat4 {
     )
 }
 
-/// Converts to the `f32` output, refusing non-finite or singular results.
+/// Converts to the `f32` output, refusing non-finite or singular results: the
+/// matrices must be invertible for world coordinates up to `world_scale`
+/// (`shadowmap_frustum::is_invertible`).
 pub(crate) fn finish(
     light_from_world: DMat4,
     clip_from_world: DMat4,
     reversed_z: bool,
     light: DVec3,
+    world_scale: f64,
 ) -> Result<ShadowTransform, WarpError> {
     let clip = clip_from_world.as_mat4();
     let lfw = light_from_world.as_mat4();
-    if !(matrix_ok(&clip) && matrix_ok(&lfw)) {
+    let scale = world_scale as f32;
+    if !(matrix_ok(&clip)
+        && matrix_ok(&lfw)
+        && scale.is_finite()
+        && shadowmap_frustum::is_invertible(&clip, scale))
+    {
         return Err(WarpError::Degenerate);
     }
     let t = ShadowTransform::new(

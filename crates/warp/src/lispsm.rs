@@ -5,8 +5,8 @@ use shadowmap_frustum::{Camera, ShadowTransform, math};
 
 use crate::WarpError;
 use crate::focus::{
-    Bounds, Focus, FocusScene, View, finish, focus, ortho_fit, scale_of, smoothstep, sqrt0,
-    transform_points,
+    Bounds, Focus, FocusBody, FocusScene, View, finish, footprint_weight, ortho_fit, scale_of,
+    smoothstep, sqrt0, transform_points,
 };
 
 /// Largest warp ratio `1 + s d` (near-to-far texel scale along the warp axis) a
@@ -58,7 +58,8 @@ pub struct LispsmOptions {
     /// uses `max(z_near, near_hint)`. Default 0 (none).
     pub near_hint: f32,
     /// View depth beyond which shadows matter little: `n_opt` uses
-    /// `min(z_far, far_hint)`. Default infinity (none).
+    /// `min(z_far, far_hint)`. Default infinity (none). Must not be below
+    /// [`near_hint`](Self::near_hint) ([`WarpError::InvalidOption`]).
     pub far_hint: f32,
     /// Angle (degrees) between view and light direction above which the warp has full
     /// strength. Default 10.
@@ -123,7 +124,7 @@ impl LispsmOptions {
             && self.near_hint >= 0.0
             && self.near_hint.is_finite()
             && self.far_hint > 0.0
-            && !self.far_hint.is_nan()
+            && self.far_hint >= self.near_hint
             && self.fade_end_deg >= 0.0
             && self.fade_start_deg > self.fade_end_deg
             && self.fade_start_deg <= 90.0;
@@ -168,9 +169,7 @@ pub fn uniform_focused(
     scene: &FocusScene,
     options: &UniformOptions,
 ) -> Result<ShadowTransform, WarpError> {
-    let view = View::camera(camera)?;
-    let f = focus(&view, light_direction, scene)?;
-    warp_fit(&f, &view, 0.0, options.reversed_z).map(|(t, _)| t)
+    FocusBody::new(camera, light_direction, scene)?.uniform(options)
 }
 
 /// Light space perspective shadow map (Wimmer, Scherzer and Purgathofer 2004) with the
@@ -185,28 +184,36 @@ pub fn lispsm(
     options: &LispsmOptions,
 ) -> Result<LispsmShadow, WarpError> {
     options.check()?;
-    let view = View::camera(camera)?;
-    lispsm_view(&view, light_direction, scene, options)
+    FocusBody::new(camera, light_direction, scene)?.lispsm(options)
 }
 
-pub(crate) fn lispsm_view(
-    view: &View,
-    light_direction: Vec3,
-    scene: &FocusScene,
-    options: &LispsmOptions,
-) -> Result<LispsmShadow, WarpError> {
-    let f = focus(view, light_direction, scene)?;
-    let (s, fade) = warp_strength(&f, view, options);
-    let (transform, s) = warp_fit(&f, view, s, options.reversed_z)?;
-    Ok(LispsmShadow {
-        transform,
-        n: if s > 0.0 {
-            (1.0 / s) as f32
-        } else {
-            f32::INFINITY
-        },
-        fade: fade as f32,
-    })
+impl FocusBody {
+    /// The uniform focused fit of this body (see [`uniform_focused`]).
+    ///
+    /// # Errors
+    /// [`WarpError::Degenerate`] when the `f32` result would be singular.
+    pub fn uniform(&self, options: &UniformOptions) -> Result<ShadowTransform, WarpError> {
+        warp_fit(&self.focus, &self.view, 0.0, options.reversed_z).map(|(t, _)| t)
+    }
+
+    /// The LiSPSM fit of this body (see [`lispsm`]).
+    ///
+    /// # Errors
+    /// [`WarpError::InvalidOption`]; [`WarpError::Degenerate`].
+    pub fn lispsm(&self, options: &LispsmOptions) -> Result<LispsmShadow, WarpError> {
+        options.check()?;
+        let (s, fade) = warp_strength(&self.focus, &self.view, options);
+        let (transform, s) = warp_fit(&self.focus, &self.view, s, options.reversed_z)?;
+        Ok(LispsmShadow {
+            transform,
+            n: if s > 0.0 {
+                (1.0 / s) as f32
+            } else {
+                f32::INFINITY
+            },
+            fade: fade as f32,
+        })
+    }
 }
 
 /// The warp strength `s = 1/n` and the fade weight.
@@ -217,8 +224,19 @@ fn warp_strength(f: &Focus, view: &View, o: &LispsmOptions) -> (f64, f64) {
         math::sin(f64::from(o.fade_start_deg) * deg),
         f.sin_gamma,
     );
-    if fade <= 0.0 || o.eta <= -1.0 {
-        return (0.0, fade);
+    let hints = (f64::from(o.near_hint), f64::from(o.far_hint));
+    (strength(f, view, f64::from(o.eta), hints, fade), fade)
+}
+
+/// LiSPSM's warp strength `s = 1/n` for strength parameter `eta`, view-depth hints
+/// `(near, far)` and parallel-light fade weight `fade` (0 when the fit is uniform).
+///
+/// `ln(1 + s d)`, `d` the body's extent along the warp axis, is interpolated in
+/// `eta` between uniform, `n_opt` and `n_psm`, clamped to `ln MAX_WARP_RATIO` and
+/// scaled by `fade`, so the warp ratio goes continuously to 1 as `fade` goes to 0.
+pub(crate) fn strength(f: &Focus, view: &View, eta: f64, hints: (f64, f64), fade: f64) -> f64 {
+    if fade <= 0.0 || eta <= -1.0 {
+        return 0.0;
     }
     // View-depth range of the visible receivers, narrowed by the hints.
     let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -228,18 +246,13 @@ fn warp_strength(f: &Focus, view: &View, o: &LispsmOptions) -> (f64, f64) {
         z_f = z_f.max(d);
     }
     let z_scale = z_f.abs().max(z_n.abs()).max(f64::MIN_POSITIVE);
-    z_n = z_n.max(f64::from(o.near_hint)).max(1e-6 * z_scale);
-    z_f = z_f.min(f64::from(o.far_hint)).max(z_n);
+    z_n = z_n.max(hints.0).max(1e-6 * z_scale);
+    z_f = z_f.min(hints.1).max(z_n);
     // Extent of the body along the warp axis.
-    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
-    for p in &f.casters {
-        let y = f.rot.transform_point3(*p).y;
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
+    let (y0, y1) = f.warp_axis_range();
     let d = (y1 - y0).max(0.0);
     if !(d > 0.0) {
-        return (0.0, fade);
+        return 0.0;
     }
     let sin_g = f.sin_gamma;
     // Wimmer et al.: n_opt = (z_n + sqrt(z_n z_f)) / sin(gamma); PSM: n = z_n / sin(gamma).
@@ -247,7 +260,6 @@ fn warp_strength(f: &Focus, view: &View, o: &LispsmOptions) -> (f64, f64) {
     let s_psm = sin_g / z_n;
     let ln_r_lisp = ln_1p(s_lisp * d);
     let ln_r_psm = ln_1p(s_psm * d);
-    let eta = f64::from(o.eta);
     let ln_r = if eta <= 0.0 {
         (1.0 + eta) * ln_r_lisp
     } else {
@@ -255,11 +267,7 @@ fn warp_strength(f: &Focus, view: &View, o: &LispsmOptions) -> (f64, f64) {
     };
     let ln_r = ln_r.min(math::ln(MAX_WARP_RATIO)) * fade;
     let s = (math::exp(ln_r) - 1.0) / d;
-    if s.is_finite() && s > 0.0 {
-        (s, fade)
-    } else {
-        (0.0, fade)
-    }
+    if s.is_finite() && s > 0.0 { s } else { 0.0 }
 }
 
 fn ln_1p(x: f64) -> f64 {
@@ -287,7 +295,12 @@ pub(crate) fn warp_fit(
     for p in &ls_casters {
         lb.add(*p);
     }
-    let s = s.min(MAX_WARP_RATIO / scale_of(&ls_casters)).max(0.0);
+    let scale = scale_of(&f.casters);
+    // A footprint too thin for f32 texels gets the widened uniform fit.
+    let wide = footprint_weight(&f.rot, &f.receivers, scale_of(&f.receivers));
+    let s = (s * wide)
+        .min(MAX_WARP_RATIO / scale_of(&ls_casters))
+        .max(0.0);
     let eye = f.rot.transform_point3(view.eye);
     let x_c = eye.x.max(lb.min.x).min(lb.max.x);
     let y0 = lb.min.y;
@@ -312,9 +325,9 @@ pub(crate) fn warp_fit(
     if b.is_empty() || !(b.min.is_finite() && b.max.is_finite()) {
         return Err(WarpError::Degenerate);
     }
-    let b = b.padded(scale_of(&f.casters));
+    let b = b.padded(scale, 1.0 - wide);
     let clip = ortho_fit(&b, reversed_z) * warp_from_world;
-    finish(f.rot, clip, reversed_z, f.light).map(|t| (t, s))
+    finish(f.rot, clip, reversed_z, f.light, scale).map(|t| (t, s))
 }
 
 #[cfg(test)]
@@ -464,6 +477,8 @@ mod tests {
             LispsmOptions::default().with_eta(f32::NAN),
             LispsmOptions::default().with_fade(3.0, 10.0),
             LispsmOptions::default().with_hints(-1.0, 10.0),
+            LispsmOptions::default().with_hints(5.0, 2.0),
+            LispsmOptions::default().with_hints(0.0, f32::NAN),
         ] {
             assert_eq!(
                 lispsm(&camera, Vec3::NEG_Y, &scene, &o).err(),

@@ -1,9 +1,11 @@
 //! Trapezoidal shadow maps (Martin and Tan 2004).
 
+use arrayvec::ArrayVec;
 use glam::Vec3;
-use shadowmap_frustum::{Camera, ShadowTransform, math};
+use shadowmap_frustum::{Camera, MAX_BODY_VERTICES, ShadowTransform, math};
 
-use crate::focus::{FocusScene, View, focus, smoothstep};
+use crate::FocusBody;
+use crate::focus::{Focus, FocusScene, View, smoothstep};
 use crate::lispsm::warp_fit;
 use crate::{MAX_WARP_RATIO, WarpError};
 
@@ -95,15 +97,21 @@ pub struct TsmShadow {
 /// line runs along the view direction, which is the light frame's `+Y`
 /// ([`light_frame`](crate::light_frame)); the top and base edges of the trapezoid
 /// are perpendicular to it and touch the visible receivers (frustum ∩ receivers) on
-/// the near and far side, `λ` apart. The focus point at distance `δ'` from the top
-/// edge (see [`TsmOptions::focus`]) is mapped to the 80% line (`ξ = -0.6`):
+/// the near and far side, `λ` apart. The focus region, the visible receivers nearer
+/// than the focus depth (see [`TsmOptions::focus`]), reaches `δ'` from the top edge
+/// and is mapped inside the 80% line (`ξ = -0.6`):
 ///
 /// ```text
 /// η = λ δ' (1 + ξ) / (λ (1 - ξ) - 2 δ')      (rectangle when δ' >= 0.8 λ)
 /// ```
 ///
 /// and the sides are the tangents from the apex, `η` before the top edge, to the
-/// receivers. The trapezoid-to-square map is the projective warp of
+/// receivers. When the view depth orders the receivers along the centre line (the
+/// usual case: the near plane projects onto the top edge) the focus region ends at
+/// the focus point on the centre line, as in the paper. When it does not (a camera
+/// looking down, or toward the light) the nearest receivers spread over the whole
+/// trapezoid, `δ'` reaches `0.8 λ` and the trapezoid becomes the rectangle of the
+/// uniform fit instead of magnifying a strip that is no nearer than the rest. The trapezoid-to-square map is the projective warp of
 /// [`lispsm`](crate::lispsm) with `n = η`, followed by the same fit, so depth is
 /// handled as in LiSPSM (linear along every light ray, casters kept) rather than
 /// with TSM's separate depth pass.
@@ -117,8 +125,21 @@ pub fn tsm(
     options: &TsmOptions,
 ) -> Result<TsmShadow, WarpError> {
     options.check()?;
-    let view = View::camera(camera)?;
-    let f = focus(&view, light_direction, scene)?;
+    FocusBody::new(camera, light_direction, scene)?.tsm(options)
+}
+
+impl FocusBody {
+    /// The TSM fit of this body (see [`tsm`]).
+    ///
+    /// # Errors
+    /// [`WarpError::InvalidOption`]; [`WarpError::Degenerate`].
+    pub fn tsm(&self, options: &TsmOptions) -> Result<TsmShadow, WarpError> {
+        options.check()?;
+        tsm_body(&self.view, &self.focus, options)
+    }
+}
+
+fn tsm_body(view: &View, f: &Focus, options: &TsmOptions) -> Result<TsmShadow, WarpError> {
     let deg = core::f64::consts::PI / 180.0;
     let fade = smoothstep(
         math::sin(f64::from(options.fade_end_deg) * deg),
@@ -128,6 +149,7 @@ pub fn tsm(
     // Top and base edges: the receivers' extent along the centre line.
     let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
     let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
+    let mut yd: ArrayVec<(f64, f64), MAX_BODY_VERTICES> = ArrayVec::new();
     for p in &f.receivers {
         let y = f.rot.transform_point3(*p).y;
         y0 = y0.min(y);
@@ -135,12 +157,13 @@ pub fn tsm(
         let d = (*p - view.eye).dot(view.forward);
         z_n = z_n.min(d);
         z_f = z_f.max(d);
+        yd.push((y, d));
     }
     let lambda = y1 - y0;
-    // The focus point on the centre line.
+    // The focus region: the visible receivers nearer than the focus depth; the
+    // 80% line must hold all of it.
     let z_focus = z_n + f64::from(options.focus) * (z_f - z_n);
-    let focus_point = view.eye + view.forward * z_focus;
-    let delta = (f.rot.transform_point3(focus_point).y - y0).clamp(0.0, lambda.max(0.0));
+    let delta = (focus_region_top(&yd, z_focus) - y0).clamp(0.0, lambda.max(0.0));
     const XI: f64 = -0.6;
     let denom = lambda * (1.0 - XI) - 2.0 * delta;
     let mut s = if lambda > 0.0 && denom > 0.0 && delta > 0.0 {
@@ -153,7 +176,7 @@ pub fn tsm(
         s = s.min((MAX_WARP_RATIO - 1.0) / lambda);
     }
     let s = if s.is_finite() { s * fade } else { 0.0 };
-    let (transform, s) = warp_fit(&f, &view, s, options.reversed_z)?;
+    let (transform, s) = warp_fit(f, view, s, options.reversed_z)?;
     Ok(TsmShadow {
         transform,
         eta: if s > 0.0 {
@@ -162,6 +185,22 @@ pub fn tsm(
             f32::INFINITY
         },
     })
+}
+
+/// Largest `y` over the part of a convex body with depth `d <= z`, from the body's
+/// vertices as `(y, d)`: the maximum of a linear function over the body clipped by a
+/// half-space lies at a vertex inside it or where an edge crosses the plane, and every
+/// segment between two vertices lies in the body, so the vertex pairs cover it.
+fn focus_region_top(yd: &[(f64, f64)], z: f64) -> f64 {
+    let mut top = f64::NEG_INFINITY;
+    for &(ya, da) in yd.iter().filter(|(_, d)| *d <= z) {
+        top = top.max(ya);
+        for &(yb, db) in yd.iter().filter(|(_, d)| *d > z) {
+            let t = (z - da) / (db - da);
+            top = top.max(ya + (yb - ya) * t);
+        }
+    }
+    top
 }
 
 #[cfg(test)]

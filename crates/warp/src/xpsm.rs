@@ -4,8 +4,9 @@ use arrayvec::ArrayVec;
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap_frustum::{Camera, ShadowTransform};
 
+use crate::FocusBody;
 use crate::WarpError;
-use crate::focus::{Bounds, View, finish, focus, scale_of, smoothstep, sqrt0};
+use crate::focus::{Bounds, Focus, View, finish, footprint_weight, scale_of, smoothstep};
 
 /// Options of [`xpsm`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,8 +19,10 @@ pub struct XpsmOptions {
     /// critical case (casters behind the viewer). Default 0.1.
     pub epsilon_w: f32,
     /// `coef` of the paper (inverse world units): warping `1 / (coef d + 1)` at view
-    /// distance `d`. `None` (default) picks `1 / sqrt(z_n z_f)` from the visible
-    /// receivers, which equals LiSPSM's `n_opt` warp for an overhead light.
+    /// distance `d`, `lengthP = coef / cos γ`. `None` (default) uses
+    /// `coef = 1 / sqrt(z_n z_f)` from the visible receivers and keeps the warp
+    /// ratio it means over the visible region wherever that region lies (see
+    /// [`xpsm`], step 6).
     pub coef: Option<f32>,
     /// `|V_xy|` (the sine of the angle between view and light) below which the
     /// miner's-lamp case applies: orthographic shadows with focusing. The paper
@@ -140,7 +143,8 @@ type Cloud = ArrayVec<Hom, 1100>;
 /// receivers; casters the corners of the caster box.
 ///
 /// 1. Light space: the shared light frame ([`light_frame`](crate::light_frame)) with
-///    its origin at the viewer.
+///    its origin at the viewer (for the automatic length of step 6, moved along
+///    `unit P` to the near face of the focus body).
 /// 2. The view vector in light space, `V`.
 /// 3. `unit P = V_xy / |V_xy|`, which is the frame's `+Y` whenever `V_xy` is not tiny
 ///    (in the near-parallel band the frame turns continuously toward the camera's
@@ -151,7 +155,15 @@ type Cloud = ArrayVec<Hom, 1100>;
 /// 4. `minCastersProj`, `minReceiversProj`: smallest projections on `unit P`.
 /// 5. `maxLengthP = (epsilonW - 1) / max(minCastersProj, minReceiversProj)` when the
 ///    focus interval starts behind the viewer (no bound otherwise).
-/// 6. `lengthP = coef / cos γ`, `cos γ = |V_xy|`.
+/// 6. `lengthP = coef / cos γ`, `cos γ = |V_xy|`, for a given
+///    [`XpsmOptions::coef`]. By default the warp ratio the paper's
+///    `coef = 1 / sqrt(z_n z_f)` means over the visible depth range,
+///    `1 + coef (z_f - z_n)`, is spread over the receivers' extent `D` along
+///    `unit P`, `lengthP = coef (z_f - z_n) / D`, and the origin of step 1 moves
+///    along `unit P` from the viewer to the near face of the focus body. This equals
+///    the paper's length and origin when the visible region starts at the viewer
+///    and its extent is the depth range times `cos γ`; a camera looking down or
+///    toward the light breaks both, and the paper's length then over-warps.
 /// 7. Clip: `lengthP = min(lengthP, maxLengthP)` when `maxLengthP > 0`. Then two
 ///    precision guards: `1 + lengthP * maxProj <= MAX_WARP_RATIO` and
 ///    `lengthP <= MAX_WARP_RATIO / L` ([`MAX_WARP_RATIO`](crate::MAX_WARP_RATIO)).
@@ -199,18 +211,42 @@ pub fn xpsm(
     options: &XpsmOptions,
 ) -> Result<XpsmShadow, WarpError> {
     options.validate()?;
-    let view = View::camera(camera)?;
-    let f = focus(&view, light_direction, scene)?;
+    FocusBody::new(camera, light_direction, scene)?.xpsm(options)
+}
+
+impl FocusBody {
+    /// The XPSM fit of this body (see [`xpsm`]).
+    ///
+    /// # Errors
+    /// [`WarpError::InvalidOption`]; [`WarpError::EmptyFocusRegion`];
+    /// [`WarpError::Degenerate`].
+    pub fn xpsm(&self, options: &XpsmOptions) -> Result<XpsmShadow, WarpError> {
+        options.validate()?;
+        xpsm_body(&self.view, &self.focus, options)
+    }
+}
+
+fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow, WarpError> {
+    let view = *view;
     let eps_w = f64::from(options.epsilon_w);
 
-    // Step 1: light space, origin at the viewer, light along -Z.
-    let light_space = f.rot * DMat4::from_translation(-view.eye);
     // Steps 2-3: view vector in light space and its xy direction. The shared light
     // frame has +Y along V_xy whenever V_xy is not tiny, so unit P = (0, 1); in the
     // near-parallel band the frame follows the camera's up vector continuously.
     let v_xy = f.sin_gamma;
     let thr = f64::from(options.miner_lamp_threshold);
     let weight = smoothstep(thr, 2.0 * thr, v_xy);
+    // Step 6 (first, since the automatic length places the origin): optimal length.
+    let (mut length_p, shift) = match options.coef {
+        Some(c) if weight > 0.0 => (weight * f64::from(c) / v_xy, 0.0),
+        Some(_) => (0.0, 0.0),
+        None => auto_length(f, &view, weight),
+    };
+    // Step 1: light space, origin at the viewer (moved along unit P by `shift` for
+    // the automatic length), light along -Z.
+    let light_space = DMat4::from_translation(DVec3::new(0.0, -shift, 0.0))
+        * f.rot
+        * DMat4::from_translation(-view.eye);
     let unit_p = glam::DVec2::Y;
 
     let receivers: ArrayVec<DVec3, 64> = f
@@ -242,16 +278,6 @@ pub fn xpsm(
     } else {
         f64::INFINITY
     };
-    // Step 6: optimal length, coef / cos(gamma) with cos(gamma) = |V_xy|.
-    let coef = match options.coef {
-        Some(c) => f64::from(c),
-        None => auto_coef(&f.receivers, &view),
-    };
-    let mut length_p = if weight > 0.0 {
-        weight * coef / v_xy
-    } else {
-        0.0
-    };
     // Step 7: clip against the back-projection singularity.
     if max_length_p > 0.0 && length_p > max_length_p {
         length_p = max_length_p;
@@ -262,7 +288,18 @@ pub fn xpsm(
     }
     // The f32 matrix computes w in world coordinates: keep its rounding small (see
     // MAX_WARP_RATIO).
-    length_p = length_p.min(crate::MAX_WARP_RATIO / scale_of(&f.casters));
+    let world_scale = scale_of(&f.casters).max(
+        f.caster_box
+            .min
+            .abs()
+            .max(f.caster_box.max.abs())
+            .max_element()
+            .into(),
+    );
+    length_p = length_p.min(crate::MAX_WARP_RATIO / world_scale);
+    // A footprint too thin for f32 texels gets the widened uniform fit.
+    let wide = footprint_weight(&f.rot, &f.receivers, scale_of(&f.receivers));
+    length_p *= wide;
     if !(length_p.is_finite() && length_p >= 0.0) {
         length_p = 0.0;
     }
@@ -318,7 +355,7 @@ pub fn xpsm(
     // Step 14: Z range over both boxes (points with w < epsilonW excluded).
     region.min.z = cz.0.min(rz.0);
     region.max.z = cz.1.max(rz.1);
-    let region = region.padded(scale_of(&f.casters));
+    let region = region.padded(world_scale, 1.0 - wide);
     let (min, max) = (region.min, region.max);
     let ext = max - min;
     // Step 15: unit cube = inverse of the focus region basis.
@@ -347,7 +384,7 @@ pub fn xpsm(
     };
     // Step 17: the final transformation (View * LightSpace folded into light_space).
     let clip = normalized * unit_cube * ppls * light_space;
-    let transform = finish(f.rot, clip, options.reversed_z, f.light)?;
+    let transform = finish(f.rot, clip, options.reversed_z, f.light, world_scale)?;
     // Step 18: Z bias scale, 1 / (MaxZ - MinZ).
     let z_bias_scale = (1.0 / ext.z) as f32;
     if !(z_bias_scale.is_finite() && z_bias_scale > 0.0) {
@@ -362,19 +399,49 @@ pub fn xpsm(
     })
 }
 
-/// `1 / sqrt(z_n z_f)` over the visible receivers' view depths.
-fn auto_coef(receivers: &[DVec3], view: &View) -> f64 {
+/// The automatic `lengthP`, faded by `weight`.
+///
+/// The paper warps by `w = 1 + coef d` at view distance `d`, `coef = 1 / sqrt(z_n z_f)`
+/// over the visible receivers, so the warp ratio across the visible depth range is
+/// `1 + coef (z_f - z_n)`; its `lengthP = coef / cos γ` reaches that ratio only when
+/// the light-space extent of the visible region along `unit P` is the depth range
+/// times `cos γ` (the paper's `γ`, here `sin γ`) and the region starts at the
+/// viewer. Neither holds when the light is near the view (a camera looking down, a
+/// low sun ahead): the region spreads sideways and reaches behind the viewer, and
+/// the paper's length then over-warps it, and the back-projection clip of step 7
+/// drives one edge to `epsilonW` (ten times magnified, the rest starved). So the
+/// ratio is kept, and placed on the region: `lengthP = coef (z_f - z_n) / D`, `D`
+/// the receivers' extent along `unit P`, with the light-space origin moved along
+/// `unit P` from the viewer to the near face `y_0` of the focus body (the returned
+/// shift `y_0 - y_eye`), so the projection centre lies `1 / lengthP` before the
+/// region wherever the viewer is. In the paper's own setting
+/// (`D = (z_f - z_n) cos γ`, region starting at the viewer) this is its
+/// `coef / cos γ` with its origin. Returns `(lengthP, shift)`.
+fn auto_length(f: &Focus, view: &View, weight: f64) -> (f64, f64) {
+    if !(weight > 0.0) {
+        return (0.0, 0.0);
+    }
     let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
-    for p in receivers {
+    let (mut r0, mut r1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in &f.receivers {
         let d = (*p - view.eye).dot(view.forward);
         z_n = z_n.min(d);
         z_f = z_f.max(d);
+        let y = f.rot.transform_point3(*p).y;
+        r0 = r0.min(y);
+        r1 = r1.max(y);
     }
     let z_scale = z_f.abs().max(z_n.abs()).max(f64::MIN_POSITIVE);
     let z_n = z_n.max(1e-6 * z_scale);
     let z_f = z_f.max(z_n);
-    let c = 1.0 / sqrt0(z_n * z_f);
-    if c.is_finite() { c } else { 0.0 }
+    let coef = 1.0 / crate::focus::sqrt0(z_n * z_f);
+    let s = weight * coef * (z_f - z_n) / (r1 - r0);
+    if !(s.is_finite() && s > 0.0) {
+        return (0.0, 0.0);
+    }
+    let (y0, _) = f.warp_axis_range();
+    let y_eye = f.rot.transform_point3(view.eye).y;
+    (s, y0 - y_eye)
 }
 
 /// PPLS points of a vertex set, split by the plane `w = eps_w`: every vertex (those

@@ -171,7 +171,7 @@ const RES: f64 = 2048.0;
 /// that times the map's largest stretch `s` over the region (largest singular value
 /// of the uv Jacobian). `C = 16` leaves room for the refit of the bounds and the warp strength.
 /// The frame itself turns by at most 20 δ, except close to its two singular
-/// directions, which lie in the blend band 2 to 10 degrees from the view.
+/// directions, 1 degree from the view: within 3.5 degrees of the view it may turn faster.
 fn check_motion(
     case: &WarpCase,
     build: &dyn Fn(&WarpCase) -> Result<ShadowTransform, WarpError>,
@@ -195,7 +195,7 @@ fn check_motion(
     let theta = frame_turn(case, l2);
     let ang = view_light_angle(case, case.light).min(view_light_angle(case, l2));
     prop_assert!(
-        theta <= 20.0 * delta || (1.5..=10.5).contains(&ang),
+        theta <= 20.0 * delta || ang <= 3.5,
         "frame turned {theta} rad at {ang} deg"
     );
     let mut u = Unstructured::new(bytes);
