@@ -28,6 +28,9 @@ use glam::{DVec3, Vec3};
 use shadowmap_frustum::{Camera, Light, Projection};
 
 use crate::EvalError;
+use crate::bvh::Bvh;
+use crate::mask::GBuffer;
+use crate::metrics::{SurfacePoint, is_front_lit};
 use crate::scene::{Mesh, Scene};
 
 /// Knobs shared by every configuration.
@@ -519,6 +522,11 @@ pub fn mesh_configuration(
 /// and seed), for the robustness sweep of `compare --sweep`: named
 /// `random_<scene>_<k>`, each with a one-frame camera path.
 ///
+/// A draw that would measure little (a camera inside a building or facing the sky,
+/// a light that reaches nothing it sees) is drawn again, up to 32 times: on a
+/// 16×9 preview at least half the pixels must see a surface and a quarter one lit
+/// from the front.
+///
 /// Case `k` of a scene has a directional light when `k % 3 == 0`, a spot light when
 /// `k % 3 == 1` and a point light otherwise. The camera stands anywhere over the
 /// scene's footprint, between 0.05 and 0.6 of the scene's height above its floor
@@ -531,7 +539,8 @@ pub fn mesh_configuration(
 /// depend only on `options.seed`, the scene and `k`.
 ///
 /// # Errors
-/// [`EvalError::InvalidView`] as [`CameraPath::sample`].
+/// [`EvalError::InvalidView`] as [`CameraPath::sample`]; the BVH's errors for a
+/// scene it cannot hold.
 pub fn sweep_configurations(
     options: &ConfigOptions,
     count: usize,
@@ -549,9 +558,18 @@ pub fn sweep_configurations(
         };
         let (min, max) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
         let mut rng = SweepRng(options.seed ^ (0x5EE9_0000_0000 + s as u64));
+        let bvh = Bvh::build(&scene.mesh)?;
         for k in 0..count {
-            let (path, forward) = sweep_camera(&mut rng, min, max);
-            let light = sweep_light(&mut rng, k, min, max, forward);
+            let mut attempts = 0;
+            let (path, forward, light, cameras) = loop {
+                let (path, forward) = sweep_camera(&mut rng, min, max);
+                let light = sweep_light(&mut rng, k, min, max, forward);
+                let cameras = path.sample(1, options.aspect)?;
+                attempts += 1;
+                if attempts >= SWEEP_ATTEMPTS || measurable(&bvh, &cameras[0], &light)? {
+                    break (path, forward, light, cameras);
+                }
+            };
             let eye = path.eye;
             configs.push(Configuration {
                 name: format!("random_{}_{k:03}", scene.name),
@@ -567,11 +585,37 @@ pub fn sweep_configurations(
                 ),
                 scene: Arc::clone(scene),
                 light,
-                path: path.sample(1, options.aspect)?,
+                path: cameras,
             });
         }
     }
     Ok(configs)
+}
+
+/// Draws per sweep case before one is taken even if it measures little.
+const SWEEP_ATTEMPTS: usize = 32;
+
+/// Whether a draw gives something to measure: on a 16×9 preview, at least half the
+/// pixels see a surface and a quarter see one lit from the front.
+fn measurable(bvh: &Bvh, camera: &Camera, light: &Light) -> Result<bool, EvalError> {
+    let (w, h) = (16u32, 9u32);
+    let gbuffer = GBuffer::trace(bvh, camera, w, h)?;
+    let front_lit = gbuffer
+        .surfaces
+        .iter()
+        .flatten()
+        .filter(|s| {
+            is_front_lit(
+                light,
+                &SurfacePoint {
+                    position: s.position,
+                    normal: s.normal,
+                },
+            )
+        })
+        .count();
+    let pixels = (w * h) as usize;
+    Ok(2 * gbuffer.visible_count() >= pixels && 4 * front_lit >= pixels)
 }
 
 fn sweep_camera(rng: &mut SweepRng, min: DVec3, max: DVec3) -> (CameraPath, DVec3) {
