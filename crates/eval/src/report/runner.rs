@@ -29,7 +29,8 @@ use super::{Options, Report, Settings};
 /// [`EvalError::InvalidOption`] for zero threads; [`EvalError::Write`] (with the
 /// path and the reason) when `options.out` cannot be created or replaced, or a
 /// file cannot be written; the import errors for a
-/// bad `--mesh`; [`EvalError::InvalidView`] / [`EvalError::InvalidMesh`] for a
+/// bad `--mesh`, [`EvalError::UnusableMesh`] for one without area or too large for
+/// an `f32` camera; [`EvalError::InvalidView`] / [`EvalError::InvalidMesh`] for a
 /// configuration that cannot be traced. A technique that cannot be built is not an
 /// error: its row says "n/a (reason)".
 pub fn run(options: &Options) -> Result<Report, EvalError> {
