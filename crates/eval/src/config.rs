@@ -6,7 +6,7 @@
 //!
 //! | name | scene | light | what it shows |
 //! |---|---|---|---|
-//! | `overhead` | city block | directional, straight down | the textbook case of GUIDE §5 (`n = 1`, `f = 1000`, fovY 60°, view horizontal) |
+//! | `overhead` | city block | directional, straight down | the textbook case of the closed-form storage factors (`n = 1`, `f = 1000`, fovY 60°, view horizontal) |
 //! | `behind` | city block | directional, from behind the viewer (10° from the view direction) | light almost along the view: warps fade toward uniform |
 //! | `facing` | city block | directional, toward the viewer (142° from the view direction) | dueling frusta |
 //! | `facing_spot` | city block | spot in front, aimed at the viewer | dueling frusta with a perspective light |
@@ -28,6 +28,9 @@ use glam::{DVec3, Vec3};
 use shadowmap_frustum::{Camera, Light, Projection};
 
 use crate::EvalError;
+use crate::bvh::Bvh;
+use crate::mask::GBuffer;
+use crate::metrics::{SurfacePoint, is_front_lit};
 use crate::scene::{Mesh, Scene};
 
 /// Knobs shared by every configuration.
@@ -463,7 +466,8 @@ pub fn standard_configurations(options: &ConfigOptions) -> Result<Vec<Configurat
 /// the upper left (`(-0.4, -1, -0.3)`); the depth range covers the box.
 ///
 /// # Errors
-/// [`EvalError::InvalidMesh`] for a mesh without finite bounds or with zero size;
+/// [`EvalError::InvalidMesh`] for a mesh without finite bounds, with zero size, or
+/// so large that the camera's position overflows `f32`;
 /// [`EvalError::InvalidView`] as [`CameraPath::sample`].
 pub fn mesh_configuration(
     name: &str,
@@ -485,6 +489,16 @@ pub fn mesh_configuration(
     let eye = centre + dir_to_eye * distance;
     let near = (distance - radius).max(distance * 1e-3) * 0.5;
     let far = distance + 2.0 * radius;
+    // The camera is f32: its eye and planes must be finite there.
+    let reach = eye.abs().max_element() + far;
+    if !(reach as f32).is_finite() {
+        return Err(EvalError::InvalidMesh {
+            message: format!(
+                "{name}: a bounding radius of {radius:.3e} puts the camera {reach:.3e} from the \
+                 origin, beyond the f32 range of cameras"
+            ),
+        });
+    }
     let cam_path = CameraPath {
         eye,
         forward: -dir_to_eye,
@@ -502,6 +516,243 @@ pub fn mesh_configuration(
         light: directional(DVec3::new(-0.4, -1.0, -0.3)),
         path: cam_path.sample(options.path_frames, options.aspect)?,
     })
+}
+
+/// `count` random configurations per scene of the report (the same four scenes
+/// and seed), for the robustness sweep of `compare --sweep`: named
+/// `random_<scene>_<k>`, each with a one-frame camera path.
+///
+/// A draw that would measure little (a camera inside a building or facing the sky,
+/// a light that reaches nothing it sees) is drawn again, up to 32 times: on a
+/// 16×9 preview at least half the pixels must see a surface and a quarter one lit
+/// from the front.
+///
+/// Case `k` of a scene has a directional light when `k % 3 == 0`, a spot light when
+/// `k % 3 == 1` and a point light otherwise. The camera stands anywhere over the
+/// scene's footprint, between 0.05 and 0.6 of the scene's height above its floor
+/// (at least 1), looking in any horizontal direction, 50° down to 5° up; near
+/// plane 0.1 to 1, far plane 1.2 times the scene's diagonal. A directional light
+/// comes from anywhere above (a third of them within 15° of the view direction,
+/// where warps must fall back to the uniform fit); a spot light hangs above the
+/// scene aimed at a random point of its lower half, half-angle 25° to 60°; a point
+/// light stands over the footprint, 1 m to half the scene's height up. The draws
+/// depend only on `options.seed`, the scene and `k`.
+///
+/// # Errors
+/// [`EvalError::InvalidView`] as [`CameraPath::sample`]; the BVH's errors for a
+/// scene it cannot hold.
+pub fn sweep_configurations(
+    options: &ConfigOptions,
+    count: usize,
+) -> Result<Vec<Configuration>, EvalError> {
+    let scenes = [
+        Arc::new(Scene::city_block(options.seed)),
+        Arc::new(Scene::fence()),
+        Arc::new(Scene::terrain_with_trees(options.seed)),
+        Arc::new(Scene::indoor_room()),
+    ];
+    let mut configs = Vec::with_capacity(scenes.len() * count);
+    for (s, scene) in scenes.iter().enumerate() {
+        let Some(bounds) = scene.bounds() else {
+            continue;
+        };
+        let (min, max) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
+        let mut rng = SweepRng(options.seed ^ (0x5EE9_0000_0000 + s as u64));
+        let bvh = Bvh::build(&scene.mesh)?;
+        for k in 0..count {
+            let mut attempts = 0;
+            let (path, forward, light, cameras) = loop {
+                let (path, forward) = sweep_camera(&mut rng, min, max);
+                let light = sweep_light(&mut rng, k, min, max, forward);
+                let cameras = path.sample(1, options.aspect)?;
+                attempts += 1;
+                if attempts >= SWEEP_ATTEMPTS || measurable(&bvh, &cameras[0], &light)? {
+                    break (path, forward, light, cameras);
+                }
+            };
+            let eye = path.eye;
+            configs.push(Configuration {
+                name: format!("random_{}_{k:03}", scene.name),
+                description: format!(
+                    "sweep case: eye ({:.1}, {:.1}, {:.1}), view ({:.2}, {:.2}, {:.2}), {}",
+                    eye.x,
+                    eye.y,
+                    eye.z,
+                    forward.x,
+                    forward.y,
+                    forward.z,
+                    describe_light(&light)
+                ),
+                scene: Arc::clone(scene),
+                light,
+                path: cameras,
+            });
+        }
+    }
+    Ok(configs)
+}
+
+/// Draws per sweep case before one is taken even if it measures little.
+const SWEEP_ATTEMPTS: usize = 32;
+
+/// Whether a draw gives something to measure: on a 16×9 preview, at least half the
+/// pixels see a surface and a quarter see one lit from the front.
+fn measurable(bvh: &Bvh, camera: &Camera, light: &Light) -> Result<bool, EvalError> {
+    let (w, h) = (16u32, 9u32);
+    let gbuffer = GBuffer::trace(bvh, camera, w, h)?;
+    let front_lit = gbuffer
+        .surfaces
+        .iter()
+        .flatten()
+        .filter(|s| {
+            is_front_lit(
+                light,
+                &SurfacePoint {
+                    position: s.position,
+                    normal: s.normal,
+                },
+            )
+        })
+        .count();
+    let pixels = (w * h) as usize;
+    Ok(2 * gbuffer.visible_count() >= pixels && 4 * front_lit >= pixels)
+}
+
+fn sweep_camera(rng: &mut SweepRng, min: DVec3, max: DVec3) -> (CameraPath, DVec3) {
+    let size = max - min;
+    let eye = DVec3::new(
+        rng.range(min.x, max.x),
+        min.y + (size.y * rng.range(0.05, 0.6)).max(1.0),
+        rng.range(min.z, max.z),
+    );
+    let yaw = rng.range(0.0, std::f64::consts::TAU);
+    let pitch = rng.range(-50.0, 5.0).to_radians();
+    let forward = DVec3::new(
+        yaw.cos() * pitch.cos(),
+        pitch.sin(),
+        yaw.sin() * pitch.cos(),
+    );
+    let near = 10f64.powf(rng.range(-1.0, 0.0));
+    let far = 1.2 * size.length().max(10.0 * near);
+    let path = CameraPath {
+        eye,
+        forward,
+        up: DVec3::Y,
+        travel: DVec3::ZERO,
+        yaw: 0.0,
+        fov_y: 60f64.to_radians(),
+        near,
+        far,
+    };
+    (path, forward)
+}
+
+fn sweep_light(rng: &mut SweepRng, k: usize, min: DVec3, max: DVec3, forward: DVec3) -> Light {
+    let size = max - min;
+    let range = (2.0 * size.length()) as f32;
+    match k % 3 {
+        0 => {
+            let direction = if rng.range(0.0, 1.0) < 1.0 / 3.0 {
+                // Within 15° of the view direction, on the side that comes from above.
+                let a = rng.range(0.0, 15.0).to_radians();
+                let phi = rng.range(0.0, std::f64::consts::TAU);
+                let side = forward.cross(DVec3::Y).normalize_or(DVec3::X);
+                let perp = side * phi.cos() + side.cross(forward) * phi.sin();
+                let (tilted, mirrored) = (
+                    forward * a.cos() + perp * a.sin(),
+                    forward * a.cos() - perp * a.sin(),
+                );
+                if tilted.y < -0.05 {
+                    tilted
+                } else if mirrored.y < -0.05 {
+                    mirrored
+                } else {
+                    // The view looks level or up: tip the light down below it.
+                    let level = DVec3::new(forward.x, 0.0, forward.z).normalize_or(DVec3::X);
+                    let b = a.max(3f64.to_radians());
+                    level * b.cos() - DVec3::Y * b.sin()
+                }
+            } else {
+                // Uniform over directions pointing at least 3° down.
+                let y = -rng.range(0.05, 1.0);
+                let phi = rng.range(0.0, std::f64::consts::TAU);
+                let r = (1.0 - y * y).sqrt();
+                DVec3::new(r * phi.cos(), y, r * phi.sin())
+            };
+            directional(direction)
+        }
+        1 => {
+            let position = DVec3::new(
+                rng.range(min.x, max.x),
+                max.y + size.length() * rng.range(0.1, 0.5),
+                rng.range(min.z, max.z),
+            );
+            let target = DVec3::new(
+                rng.range(min.x, max.x),
+                min.y + 0.5 * size.y * rng.range(0.0, 1.0),
+                rng.range(min.z, max.z),
+            );
+            Light::Spot {
+                position: position.as_vec3(),
+                direction: (target - position).normalize_or(DVec3::NEG_Y).as_vec3(),
+                half_angle: rng.range(25.0, 60.0).to_radians() as f32,
+                range,
+            }
+        }
+        _ => Light::Point {
+            position: DVec3::new(
+                rng.range(min.x, max.x),
+                min.y + rng.range(1.0, (0.5 * size.y).max(2.0)),
+                rng.range(min.z, max.z),
+            )
+            .as_vec3(),
+            range,
+        },
+    }
+}
+
+fn describe_light(light: &Light) -> String {
+    match *light {
+        Light::Directional { direction: d } => {
+            format!("directional light ({:.2}, {:.2}, {:.2})", d.x, d.y, d.z)
+        }
+        Light::Spot {
+            position: p,
+            direction: d,
+            half_angle,
+            ..
+        } => format!(
+            "spot light at ({:.1}, {:.1}, {:.1}) toward ({:.2}, {:.2}, {:.2}), half-angle {:.0}°",
+            p.x,
+            p.y,
+            p.z,
+            d.x,
+            d.y,
+            d.z,
+            half_angle.to_degrees()
+        ),
+        Light::Point { position: p, .. } => {
+            format!("point light at ({:.1}, {:.1}, {:.1})", p.x, p.y, p.z)
+        }
+    }
+}
+
+/// The sweep's random numbers (SplitMix64: small, deterministic, no dependency).
+struct SweepRng(u64);
+
+impl SweepRng {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in `[lo, hi)`.
+    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
+    }
 }
 
 #[cfg(test)]

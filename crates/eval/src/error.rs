@@ -34,6 +34,14 @@ pub enum EvalError {
         /// The file.
         path: PathBuf,
     },
+    /// A mesh file that was read but cannot be evaluated (no area, a size no `f32`
+    /// camera can frame).
+    UnusableMesh {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
     /// A mesh with a non-finite position or an index past the end of its positions.
     InvalidMesh {
         /// What is wrong.
@@ -64,6 +72,11 @@ pub enum EvalError {
         /// Why, in words.
         reason: String,
     },
+    /// An option of the report that cannot be honoured (zero worker threads).
+    InvalidOption {
+        /// What is wrong.
+        message: String,
+    },
     /// A report file could not be written.
     Write {
         /// The file or directory.
@@ -87,6 +100,9 @@ impl fmt::Display for EvalError {
             ),
             Self::NoTriangles { path } => write!(f, "{} holds no triangle", path.display()),
             Self::InvalidMesh { message } => write!(f, "invalid mesh: {message}"),
+            Self::UnusableMesh { path, message } => {
+                write!(f, "cannot evaluate mesh {}: {message}", path.display())
+            }
             Self::InvalidRasterSize {
                 width,
                 height,
@@ -96,6 +112,7 @@ impl fmt::Display for EvalError {
                 "invalid raster size {width}x{height}x{layers} (or subpixel bits outside 1..=16)"
             ),
             Self::InvalidView { message } => write!(f, "invalid view: {message}"),
+            Self::InvalidOption { message } => write!(f, "invalid option: {message}"),
             Self::Technique { technique, reason } => write!(f, "{technique}: {reason}"),
             Self::Write { path, source } => write!(f, "cannot write {}: {source}", path.display()),
         }

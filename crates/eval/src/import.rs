@@ -2,7 +2,9 @@
 //! embedded base64 buffers, and binary `.glb`, via `gltf`).
 //!
 //! Only positions and triangles are read; materials, normals and textures are
-//! ignored (images are never loaded). Every error names the file.
+//! ignored (images are never loaded). Every error names the file and what in it is
+//! wrong. The `*_from_bytes` functions parse bytes already in memory (the loaders
+//! and the fuzz targets go through them); no input, however malformed, panics.
 //!
 //! # Example
 //!
@@ -46,24 +48,40 @@ pub fn load_mesh(path: impl AsRef<Path>) -> Result<Mesh, EvalError> {
 /// Loads every model of an OBJ file into one mesh, polygons triangulated (fan).
 ///
 /// # Errors
-/// [`EvalError::Io`] for a missing or unreadable file, [`EvalError::Malformed`] for
-/// one `tobj` cannot parse or with a non-finite position or out-of-range index,
-/// [`EvalError::NoTriangles`] for a file without faces.
+/// [`EvalError::Io`] for a missing or unreadable file; otherwise as
+/// [`obj_from_bytes`].
 pub fn load_obj(path: impl AsRef<Path>) -> Result<Mesh, EvalError> {
     let path = path.as_ref();
-    // tobj reports a missing file without the OS error: open it first to keep it.
-    std::fs::File::open(path).map_err(|source| EvalError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    obj_from_bytes(&read(path)?, path)
+}
+
+/// Parses the bytes of an OBJ file (`path` only names it in errors); material
+/// libraries are not read.
+///
+/// # Errors
+/// [`EvalError::Malformed`] for bytes that are not UTF-8 text (with the line), that
+/// `tobj` cannot parse, or with a non-finite position or out-of-range index;
+/// [`EvalError::NoTriangles`] for a file without faces.
+pub fn obj_from_bytes(bytes: &[u8], path: &Path) -> Result<Mesh, EvalError> {
+    if let Err(e) = std::str::from_utf8(bytes) {
+        let at = e.valid_up_to();
+        let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+        return Err(malformed(
+            path,
+            format!("not an OBJ text file: line {line} (byte {at}) is not UTF-8 text"),
+        ));
+    }
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) =
-        tobj::load_obj(path, &options).map_err(|e| malformed(path, e.to_string()))?;
+    let mut reader = std::io::BufReader::new(bytes);
+    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| malformed(path, format!("not a valid Wavefront OBJ file: {e}")))?;
     let mut mesh = Mesh::new();
     for model in &models {
         let m = &model.mesh;
@@ -85,44 +103,46 @@ pub fn load_obj(path: impl AsRef<Path>) -> Result<Mesh, EvalError> {
 /// Loads all meshes of a glTF file's default scene (the first scene if none is
 /// marked default, or every root node if the file has no scene), node transforms
 /// applied. Primitives in `TRIANGLES`, `TRIANGLE_STRIP` and `TRIANGLE_FAN` mode are
-/// read, non-indexed ones too; point and line primitives are skipped.
+/// read, non-indexed ones too; point and line primitives are skipped. External
+/// buffers are read relative to the file's directory.
 ///
 /// # Errors
-/// [`EvalError::Io`] for a missing or unreadable file, [`EvalError::Malformed`] for
-/// invalid JSON/GLB, a missing or short buffer, a non-finite position or an
-/// out-of-range index, [`EvalError::NoTriangles`] for a scene without triangles.
+/// [`EvalError::Io`] for a missing or unreadable file; otherwise as
+/// [`gltf_from_bytes`].
 pub fn load_gltf(path: impl AsRef<Path>) -> Result<Mesh, EvalError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| EvalError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| malformed(path, e.to_string()))?;
     let base = path.parent().unwrap_or_else(|| Path::new("."));
-    let buffers = gltf::import_buffers(&gltf.document, Some(base), gltf.blob.clone())
-        .map_err(|e| malformed(path, e.to_string()))?;
-    let document = &gltf.document;
-    let roots: Vec<gltf::Node<'_>> = match document
-        .default_scene()
-        .or_else(|| document.scenes().next())
-    {
-        Some(scene) => scene.nodes().collect(),
-        None => {
-            // No scene: every node that is nobody's child.
-            let children: Vec<usize> = document
-                .nodes()
-                .flat_map(|n| n.children().map(|c| c.index()).collect::<Vec<_>>())
-                .collect();
-            document
-                .nodes()
-                .filter(|n| !children.contains(&n.index()))
-                .collect()
-        }
-    };
+    gltf_from_bytes(&read(path)?, path, Some(base))
+}
+
+/// Parses the bytes of a `.gltf` (JSON) or `.glb` (binary) file; `path` names it in
+/// errors (and a `.glb` extension requires the binary container), external buffers
+/// are read from `base` (with `None`, a file that needs one is an error).
+///
+/// Every index of the document and every accessor's byte range are checked before
+/// any of them is followed, so no input makes the parser index out of bounds.
+///
+/// # Errors
+/// [`EvalError::Malformed`] naming what is wrong: a `.glb` without the binary
+/// header, invalid JSON, an index that names no object, a buffer that cannot be
+/// read (with its index and URI) or is shorter than declared, an accessor that
+/// overruns its buffer view, a view that overruns its buffer, a primitive without
+/// `POSITION`, a non-finite position or out-of-range vertex index;
+/// [`EvalError::NoTriangles`] for a scene without triangles.
+pub fn gltf_from_bytes(bytes: &[u8], path: &Path, base: Option<&Path>) -> Result<Mesh, EvalError> {
+    let (json, blob) = split_container(bytes, path)?;
+    let root = gltf::json::Root::from_slice(&json)
+        .map_err(|e| malformed(path, format!("invalid glTF JSON: {e}")))?;
+    check_primitive_indices(&root).map_err(|m| malformed(path, m))?;
+    let document = gltf::Document::from_json(root).map_err(|e| malformed(path, e.to_string()))?;
+    let buffers = read_buffers(&document, base, blob).map_err(|m| malformed(path, m))?;
+    check_accessors(&document).map_err(|m| malformed(path, m))?;
     let mut mesh = Mesh::new();
     // Iterative walk; the depth guard stops a cyclic (invalid) node graph.
-    let mut stack: Vec<(gltf::Node<'_>, DMat4, usize)> =
-        roots.into_iter().map(|n| (n, DMat4::IDENTITY, 0)).collect();
+    let mut stack: Vec<(gltf::Node<'_>, DMat4, usize)> = scene_roots(&document)
+        .into_iter()
+        .map(|n| (n, DMat4::IDENTITY, 0))
+        .collect();
     while let Some((node, parent, depth)) = stack.pop() {
         if depth > 256 {
             return Err(malformed(
@@ -140,6 +160,191 @@ pub fn load_gltf(path: impl AsRef<Path>) -> Result<Mesh, EvalError> {
         stack.extend(node.children().map(|c| (c, world_from_node, depth + 1)));
     }
     finish(path, mesh)
+}
+
+fn read(path: &Path) -> Result<Vec<u8>, EvalError> {
+    std::fs::read(path).map_err(|source| EvalError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// The JSON and the binary chunk of a `.glb`, or the JSON of a `.gltf`.
+fn split_container(bytes: &[u8], path: &Path) -> Result<(Vec<u8>, Option<Vec<u8>>), EvalError> {
+    let is_glb_name = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if bytes.starts_with(b"glTF") {
+        let glb = gltf::binary::Glb::from_slice(bytes)
+            .map_err(|e| malformed(path, format!("invalid GLB container: {e}")))?;
+        Ok((
+            glb.json.into_owned(),
+            glb.bin.map(std::borrow::Cow::into_owned),
+        ))
+    } else if is_glb_name {
+        Err(malformed(
+            path,
+            "not a binary glTF file: it does not start with the `glTF` magic bytes".into(),
+        ))
+    } else {
+        Ok((bytes.to_vec(), None))
+    }
+}
+
+/// Checks every accessor index a mesh primitive names (attributes, indices, morph
+/// targets) and its material, which the `gltf` crate's validation would otherwise
+/// follow unchecked.
+fn check_primitive_indices(root: &gltf::json::Root) -> Result<(), String> {
+    let accessors = root.accessors.len();
+    let check = |mesh: usize, prim: usize, what: &str, index: usize| {
+        if index < accessors {
+            Ok(())
+        } else {
+            Err(format!(
+                "mesh {mesh} primitive {prim}: {what} names accessor {index}, but the file \
+                 has {accessors} accessor(s)"
+            ))
+        }
+    };
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                let name = match semantic {
+                    gltf::json::validation::Checked::Valid(s) => s.to_string(),
+                    gltf::json::validation::Checked::Invalid => "an attribute".into(),
+                };
+                check(m, p, &name, index.value())?;
+            }
+            if let Some(index) = prim.indices {
+                check(m, p, "indices", index.value())?;
+            }
+            for target in prim.targets.iter().flatten() {
+                for index in [target.positions, target.normals, target.tangents]
+                    .into_iter()
+                    .flatten()
+                {
+                    check(m, p, "a morph target", index.value())?;
+                }
+            }
+            if let Some(material) = prim.material {
+                if material.value() >= root.materials.len() {
+                    return Err(format!(
+                        "mesh {m} primitive {p}: material {} does not exist",
+                        material.value()
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Reads every buffer; an error names the buffer, its URI and the file looked for.
+fn read_buffers(
+    document: &gltf::Document,
+    base: Option<&Path>,
+    mut blob: Option<Vec<u8>>,
+) -> Result<Vec<gltf::buffer::Data>, String> {
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let i = buffer.index();
+        let source = buffer.source();
+        let describe = match source {
+            gltf::buffer::Source::Bin => "the GLB binary chunk".to_string(),
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                "an embedded data URI".to_string()
+            }
+            gltf::buffer::Source::Uri(uri) => match base {
+                Some(base) => format!("external file {:?} ({})", uri, base.join(uri).display()),
+                None => format!("external file {uri:?}"),
+            },
+        };
+        if base.is_none()
+            && matches!(source, gltf::buffer::Source::Uri(u) if !u.starts_with("data:"))
+        {
+            return Err(format!(
+                "buffer {i} is {describe}, which cannot be read without a directory"
+            ));
+        }
+        let data = gltf::buffer::Data::from_source_and_blob(source, base, &mut blob)
+            .map_err(|e| format!("buffer {i} ({describe}): {e}"))?;
+        if data.len() < buffer.length() {
+            return Err(format!(
+                "buffer {i} ({describe}) holds {} bytes, fewer than its declared {}",
+                data.len(),
+                buffer.length()
+            ));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// Whether `len` bytes from `offset` lie inside `available`.
+fn fits(offset: usize, len: usize, available: usize) -> bool {
+    offset.checked_add(len).is_some_and(|end| end <= available)
+}
+
+/// Checks that every buffer view lies inside its buffer and every accessor's
+/// elements inside its view.
+fn check_accessors(document: &gltf::Document) -> Result<(), String> {
+    for view in document.views() {
+        let buffer = view.buffer();
+        if !fits(view.offset(), view.length(), buffer.length()) {
+            return Err(format!(
+                "buffer view {} (bytes {}..{}) overruns buffer {} of {} bytes",
+                view.index(),
+                view.offset(),
+                view.offset().saturating_add(view.length()),
+                buffer.index(),
+                buffer.length()
+            ));
+        }
+    }
+    for accessor in document.accessors() {
+        let Some(view) = accessor.view() else {
+            continue;
+        };
+        let size = accessor.size();
+        let stride = view.stride().unwrap_or(size).max(size);
+        let count = accessor.count();
+        let span = match count {
+            0 => Some(0),
+            n => stride.checked_mul(n - 1).and_then(|s| s.checked_add(size)),
+        };
+        if !span.is_some_and(|span| fits(accessor.offset(), span, view.length())) {
+            return Err(format!(
+                "accessor {} ({count} elements of {size} bytes, stride {stride}, offset {}) \
+                 overruns buffer view {} of {} bytes",
+                accessor.index(),
+                accessor.offset(),
+                view.index(),
+                view.length()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The root nodes of the default scene (or the first, or every parentless node).
+fn scene_roots(document: &gltf::Document) -> Vec<gltf::Node<'_>> {
+    match document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+    {
+        Some(scene) => scene.nodes().collect(),
+        None => {
+            let children: Vec<usize> = document
+                .nodes()
+                .flat_map(|n| n.children().map(|c| c.index()).collect::<Vec<_>>())
+                .collect();
+            document
+                .nodes()
+                .filter(|n| !children.contains(&n.index()))
+                .collect()
+        }
+    }
 }
 
 fn read_primitive(

@@ -5,12 +5,13 @@
 //! ([`bvh`], [`mask`]), a reference rasterizer that renders a technique's shadow
 //! depth map the way a GPU does ([`raster`]), the evaluation configurations
 //! ([`config`]: scene, light, scripted camera path), the techniques at an equal
-//! texel budget ([`technique`]), the aliasing metrics of GUIDE §5 ([`metrics`]) and
+//! texel budget ([`technique`]), the aliasing metrics ([`metrics`]) and
 //! the `compare` report that puts every technique side by side ([`report`]).
 //!
 //! ```text
 //! cargo run --release -p shadowmap-eval --bin compare    # report in target/shadowmap-report
 //! cargo run --release -p shadowmap-eval --bin compare -- --quick --mesh my.obj
+//! cargo run --release -p shadowmap-eval --bin compare -- --sweep 64   # + robustness sweep
 //! ```
 //!
 //! # Example

@@ -1,4 +1,4 @@
-//! Aliasing metrics of GUIDE §5, per visible pixel, in `f64`.
+//! Aliasing metrics, per visible pixel, in `f64`.
 //!
 //! For a visible surface point `p` seen through pixel `x`, let `u(p)` be a technique's
 //! full mapping to shadow-map texels (matrices, cascade choice, paraboloid, RTW warp;
@@ -20,7 +20,7 @@
 //! m        = 1 / s2                   largest extent of one texel, in pixels (1 ideal)
 //! m_u, m_v = |J^-1 e_u|, |J^-1 e_v|   extent of one texel step along u / v, in pixels
 //! m_persp  = m with n replaced by the bisector of the eye and light directions
-//! S        = (texels / visible pixels) * max(m)^2              (GUIDE §5)
+//! S        = (texels / visible pixels) * max(m)^2
 //! S_sep    = (texels / visible pixels) * max(m_u) * max(m_v)   (Lloyd et al.)
 //! ```
 //!
@@ -362,7 +362,7 @@ impl Summary {
     }
 }
 
-/// Storage factor of GUIDE §5: `(texels / pixels) * m_max²`, the texels per pixel a
+/// Storage factor: `(texels / pixels) * m_max²`, the texels per pixel a
 /// map scaled uniformly needs for `m <= 1` everywhere.
 #[must_use]
 pub fn storage_factor(texels: u64, pixels: usize, m_max: f64) -> f64 {

@@ -1,4 +1,4 @@
-//! Golden values: the storage factors of GUIDE §5 for the overhead configuration.
+//! Golden values: the closed-form storage factors for the overhead configuration.
 //!
 //! Lloyd, Tuft, Yoon and Manocha (*Warping and Partitioning for Low Error Shadow
 //! Maps*, EGSR 2006) analyse perspective aliasing over the whole view frustum, with

@@ -101,3 +101,96 @@ fn files_without_triangles_are_refused() {
         assert!(e.to_string().contains(name));
     }
 }
+
+/// A fresh directory for files a test writes.
+fn scratch(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("shadowmap-import-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// One triangle in an external buffer `uri` (36 bytes of positions); the POSITION
+/// attribute names accessor `position`, which holds `count` vertices.
+fn triangle_gltf(uri: &str, position: usize, count: usize) -> String {
+    format!(
+        r#"{{"asset":{{"version":"2.0"}},"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":{position}}}}}]}}],
+        "buffers":[{{"uri":"{uri}","byteLength":36}}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":{count},"type":"VEC3",
+        "min":[0,0,0],"max":[1,0,1]}}]}}"#
+    )
+}
+
+fn triangle_bin() -> Vec<u8> {
+    [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect()
+}
+
+fn gltf_error(tag: &str, json: &str, with_bin: bool) -> String {
+    let dir = scratch(tag);
+    if with_bin {
+        std::fs::write(dir.join("tri.bin"), triangle_bin()).unwrap();
+    }
+    let path = dir.join("mesh.gltf");
+    std::fs::write(&path, json).unwrap();
+    let e = load_mesh(&path).unwrap_err();
+    assert!(matches!(e, EvalError::Malformed { .. }), "{e:?}");
+    assert_eq!(error_path(&e), Some(path.as_path()));
+    let _ = std::fs::remove_dir_all(&dir);
+    e.to_string()
+}
+
+#[test]
+fn gltf_written_by_the_test_loads() {
+    let dir = scratch("good");
+    std::fs::write(dir.join("tri.bin"), triangle_bin()).unwrap();
+    std::fs::write(dir.join("mesh.gltf"), triangle_gltf("tri.bin", 0, 3)).unwrap();
+    let mesh = load_mesh(dir.join("mesh.gltf")).unwrap();
+    assert_eq!(mesh.triangle_count(), 1);
+    assert!(mesh.positions.contains(&DVec3::new(1.0, 0.0, 0.0)));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn gltf_position_naming_a_missing_accessor_is_named() {
+    let e = gltf_error("missing-accessor", &triangle_gltf("tri.bin", 4, 3), true);
+    assert!(e.contains("POSITION") && e.contains("accessor 4"), "{e}");
+}
+
+#[test]
+fn gltf_accessor_overrunning_its_view_is_named() {
+    let e = gltf_error("overrun", &triangle_gltf("tri.bin", 0, 10), true);
+    assert!(e.contains("accessor 0") && e.contains("overruns"), "{e}");
+    assert!(!e.contains("without POSITION"), "{e}");
+}
+
+#[test]
+fn gltf_missing_external_buffer_is_named() {
+    let e = gltf_error("no-buffer", &triangle_gltf("gone.bin", 0, 3), false);
+    assert!(e.contains("buffer 0") && e.contains("gone.bin"), "{e}");
+}
+
+#[test]
+fn bytes_that_are_not_glb_say_so() {
+    use shadowmap_eval::import::gltf_from_bytes;
+    let e = gltf_from_bytes(b"{\"not\": \"binary\"}", Path::new("x.glb"), None).unwrap_err();
+    assert!(e.to_string().contains("magic"), "{e}");
+    // A GLB header with a truncated body is a container error, not a panic.
+    let mut glb = b"glTF".to_vec();
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&1000u32.to_le_bytes());
+    let e = gltf_from_bytes(&glb, Path::new("x.glb"), None).unwrap_err();
+    assert!(matches!(e, EvalError::Malformed { .. }), "{e:?}");
+}
+
+#[test]
+fn in_memory_gltf_with_an_external_buffer_needs_a_directory() {
+    use shadowmap_eval::import::gltf_from_bytes;
+    let json = triangle_gltf("tri.bin", 0, 3);
+    let e = gltf_from_bytes(json.as_bytes(), Path::new("m.gltf"), None).unwrap_err();
+    assert!(e.to_string().contains("tri.bin"), "{e}");
+}

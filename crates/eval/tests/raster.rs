@@ -569,7 +569,7 @@ fn near_shadow_boundary(bvh: &Bvh, surface: &shadowmap_eval::mask::Surface, radi
     })
 }
 
-/// The acceptance test of issue 6: with a map far finer than the image, the reference
+/// With a map far finer than the image, the reference
 /// rasterizer and the ray caster agree exactly on every pixel whose visible point is
 /// not within about one texel of a shadow boundary (there the texel grid itself, a
 /// half-texel away from the exact ray, legitimately flips the answer). The excluded

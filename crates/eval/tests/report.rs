@@ -94,3 +94,88 @@ fn quick_runs_are_byte_identical_and_complete() {
     let _ = std::fs::remove_dir_all(&a);
     let _ = std::fs::remove_dir_all(&b);
 }
+
+#[test]
+fn sweep_counts_every_technique_against_its_baseline() {
+    use shadowmap_eval::report::TIE_BAND;
+    let dir = temp_dir("sweep");
+    let r = report::run(
+        &Options::default()
+            .with_quick(true)
+            .with_out(&dir)
+            .with_sweep(3),
+    )
+    .unwrap();
+    let sweep = r.sweep.as_ref().expect("a sweep summary");
+    // Three cases per scene (directional, spot, point), four scenes.
+    assert_eq!(sweep.cases, 12);
+    assert_eq!(r.sweep_configs.len(), 12);
+    let kinds = |kind: &str| {
+        r.sweep_configs
+            .iter()
+            .filter(|c| c.light_kind == kind)
+            .count()
+    };
+    assert_eq!(
+        (kinds("directional"), kinds("spot"), kinds("point")),
+        (4, 4, 4)
+    );
+    for t in &sweep.tallies {
+        // Every case of the technique's light is counted once.
+        let cases = r
+            .rows
+            .iter()
+            .filter(|row| row.technique == t.technique && row.config.starts_with("random_"))
+            .count();
+        assert_eq!(t.wins + t.ties + t.losses + t.unmeasured, cases);
+        if let Some(w) = &t.worst {
+            assert!(w.config.starts_with("random_") && !w.description.is_empty());
+            assert!(w.ratio().is_finite() && w.ratio() > 0.0);
+            if t.losses > 0 {
+                assert!(w.ratio() > TIE_BAND);
+            }
+        }
+    }
+    // The baselines are not counted against themselves; the warps are.
+    assert!(
+        sweep
+            .tallies
+            .iter()
+            .all(|t| t.technique != TechniqueKind::UniformFocused)
+    );
+    assert!(
+        sweep
+            .tallies
+            .iter()
+            .any(|t| t.technique == TechniqueKind::Lispsm)
+    );
+    assert!(
+        sweep
+            .tallies
+            .iter()
+            .any(|t| t.technique == TechniqueKind::IpsmExact)
+    );
+    // The rows are in the CSV, named by the case; no pictures for them.
+    let csv = std::fs::read_to_string(dir.join("metrics.csv")).unwrap();
+    assert_eq!(
+        csv.lines().filter(|l| l.starts_with("random_")).count(),
+        r.rows
+            .iter()
+            .filter(|row| row.config.starts_with("random_"))
+            .count()
+    );
+    assert!(
+        !r.files
+            .iter()
+            .any(|f| f.to_string_lossy().contains("random_"))
+    );
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(md.contains("## Robustness sweep") && md.contains("| lispsm |"));
+    let table = report::summary_table(&r);
+    assert!(table.contains("sweep: 12 random cases"));
+    assert!(
+        !table.lines().any(|l| l.starts_with("random_")),
+        "cases not listed one by one"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

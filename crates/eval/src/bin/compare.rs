@@ -1,12 +1,17 @@
 //! `compare`: every shadow-map technique on every evaluation configuration.
 //!
 //! ```text
-//! cargo run --release -p shadowmap-eval --bin compare -- [--out DIR] [--quick] [--seed N] [--mesh PATH]
+//! cargo run --release -p shadowmap-eval --bin compare -- [--out DIR] [--quick] [--seed N] [--mesh PATH] [--sweep N] [--threads N]
 //! ```
 //!
 //! Prints a summary table (median and max aliasing error, storage factor,
 //! misclassification) and writes `report.md`, `metrics.csv` and the PNG images into
 //! `--out` (default `target/shadowmap-report`). See `shadowmap_eval::report`.
+//!
+//! Every input is checked before the run starts; the report is written into a
+//! staging directory and replaces the previous one only when complete. Exit status
+//! 0 on success, 1 with a message naming the file and the reason on any error, 2
+//! for a bad command line.
 
 use std::io::IsTerminal as _;
 use std::path::PathBuf;
@@ -32,8 +37,12 @@ struct Args {
     /// Also evaluate a mesh (.obj, .gltf, .glb) with an automatic camera and light.
     #[arg(long)]
     mesh: Option<PathBuf>,
-    /// Worker threads.
-    #[arg(long, default_value_t = 2)]
+    /// Robustness sweep: this many random camera/light configurations per scene,
+    /// every technique against its baseline (0: none).
+    #[arg(long, default_value_t = 0)]
+    sweep: usize,
+    /// Worker threads (at least 1).
+    #[arg(long, default_value_t = 2, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     threads: usize,
 }
 
@@ -45,6 +54,7 @@ fn main() -> ExitCode {
         .with_seed(args.seed)
         .with_mesh(args.mesh)
         .with_threads(args.threads)
+        .with_sweep(args.sweep)
         .with_progress(std::io::stderr().is_terminal());
     match report::run(&options) {
         Ok(r) => {

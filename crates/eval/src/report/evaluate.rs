@@ -1,0 +1,323 @@
+//! One configuration evaluated: the traced frames, the ray-traced truth, and per
+//! technique the aliasing, misclassification and temporal measures.
+
+use std::path::{Path, PathBuf};
+
+use glam::{DVec2, DVec3};
+use shadowmap_frustum::{Camera, SceneBounds, ShadowMapping};
+
+use crate::EvalError;
+use crate::bvh::Bvh;
+use crate::config::Configuration;
+use crate::mask::{GBuffer, ShadowMask};
+use crate::metrics::{
+    self, ScreenGeometry, SurfacePoint, aliasing_stats, flip_rate, misclassification, phase_jitter,
+};
+use crate::raster::{DepthMap, RasterOptions};
+use crate::technique::{FrameContext, Technique, TechniqueKind, TechniqueOptions, eye_samples};
+
+use super::image::{heatmap_image, mask_image, write_png};
+use super::{ConfigSummary, Row, RowMetrics, Settings};
+
+/// Depth bias of the reference depth pass: slope-scaled, so that a receiver's
+/// depth at its exact position never lies behind the stored depth of its own texel
+/// (half a texel in each axis is at most one texel of slope).
+const SLOPE_BIAS: f64 = 1.5;
+/// Constant part of the depth pass bias, in units of the smallest resolvable depth.
+const CONSTANT_BIAS: f64 = 16.0;
+/// Lookup bias in depth units (toward the light).
+const LOOKUP_BIAS: f64 = 1e-5;
+
+/// What one configuration produced.
+pub(super) struct ConfigOutput {
+    pub(super) summary: ConfigSummary,
+    pub(super) rows: Vec<Row>,
+    pub(super) files: Vec<PathBuf>,
+}
+
+/// One frame of a configuration, traced once and shared by the techniques.
+struct Frame {
+    camera: Camera,
+    gbuffer: GBuffer,
+    samples: Vec<shadowmap_rtw::EyeSample>,
+    screen: ScreenGeometry,
+}
+
+/// What every technique of a configuration is measured against: the traced frames,
+/// the ray-traced mask of frame 0 and the fixed world points of the temporal measures.
+struct Reference {
+    frames: Vec<Frame>,
+    /// The ray-traced mask restricted to front-lit pixels.
+    truth_front_lit: Vec<Option<bool>>,
+    surfaces: Vec<Option<SurfacePoint>>,
+    fixed: Vec<DVec3>,
+    scene_bounds: SceneBounds,
+}
+
+/// One technique's measures and the per-pixel data of its pictures.
+struct Measured {
+    metrics: RowMetrics,
+    m: Vec<Option<f64>>,
+    lit: Vec<Option<bool>>,
+}
+
+/// The fixed parameters of every technique's depth pass and fit.
+struct Setup {
+    technique: TechniqueOptions,
+    raster: RasterOptions,
+}
+
+/// Evaluates every technique of `config`'s light and writes its pictures into
+/// `pictures` (none when `None`).
+///
+/// A technique that cannot be built or rasterized gives an "n/a" row; a picture that
+/// cannot be written is an error.
+pub(super) fn evaluate_config(
+    config: &Configuration,
+    bvh: &Bvh,
+    settings: &Settings,
+    pictures: Option<&Path>,
+    bar: &indicatif::ProgressBar,
+) -> Result<ConfigOutput, EvalError> {
+    let reference = Reference::trace(config, bvh, settings)?;
+    let summary = summarize(config, &reference);
+    let setup = Setup {
+        technique: TechniqueOptions::default()
+            .with_texel_budget(settings.texel_budget)
+            .with_rtw_importance_side(settings.rtw_side),
+        raster: RasterOptions::default().with_depth_bias(CONSTANT_BIAS, SLOPE_BIAS),
+    };
+    let mut rows = Vec::new();
+    let mut files = Vec::new();
+    for kind in TechniqueKind::for_light(&config.light) {
+        let outcome = match measure(kind, config, &reference, &setup) {
+            Ok(measured) => {
+                if let Some(out) = pictures {
+                    let base = format!("{}_{}", config.name, kind.name());
+                    files.extend(write_pictures(out, &base, &reference, &measured, settings)?);
+                }
+                Ok(measured.metrics)
+            }
+            Err(EvalError::Technique { reason, .. }) => Err(reason),
+            Err(other) => Err(other.to_string()),
+        };
+        rows.push(Row {
+            config: config.name.clone(),
+            technique: kind,
+            outcome,
+        });
+        bar.inc(1);
+    }
+    Ok(ConfigOutput {
+        summary,
+        rows,
+        files,
+    })
+}
+
+/// Writes the heatmap and the masks of one technique; their names, relative to `out`.
+fn write_pictures(
+    out: &Path,
+    base: &str,
+    reference: &Reference,
+    measured: &Measured,
+    settings: &Settings,
+) -> Result<[PathBuf; 2], EvalError> {
+    let (w, h) = (settings.width, settings.height);
+    let first = &reference.frames[0];
+    let heat = PathBuf::from(format!("heatmap_{base}.png"));
+    write_png(
+        &out.join(&heat),
+        &heatmap_image(w, h, &first.gbuffer, &measured.m),
+    )?;
+    let masks = PathBuf::from(format!("mask_{base}.png"));
+    write_png(
+        &out.join(&masks),
+        &mask_image(w, h, &measured.lit, &reference.truth_front_lit),
+    )?;
+    Ok([heat, masks])
+}
+
+impl Reference {
+    fn trace(config: &Configuration, bvh: &Bvh, settings: &Settings) -> Result<Self, EvalError> {
+        let (w, h) = (settings.width, settings.height);
+        let frames: Vec<Frame> = config
+            .path
+            .iter()
+            .map(|camera| {
+                let gbuffer = GBuffer::trace(bvh, camera, w, h)?;
+                let samples = eye_samples(&gbuffer, camera);
+                let screen = ScreenGeometry::new(camera, w, h)?;
+                Ok(Frame {
+                    camera: *camera,
+                    gbuffer,
+                    samples,
+                    screen,
+                })
+            })
+            .collect::<Result<_, EvalError>>()?;
+        let first = frames.first().ok_or_else(|| EvalError::InvalidView {
+            message: format!("{}: camera path without frames", config.name),
+        })?;
+        let truth = ShadowMask::ray_traced(&first.gbuffer, bvh, &config.light)?;
+        let surfaces: Vec<Option<SurfacePoint>> = first
+            .gbuffer
+            .surfaces
+            .iter()
+            .map(|s| {
+                s.as_ref().map(|s| SurfacePoint {
+                    position: s.position,
+                    normal: s.normal,
+                })
+            })
+            .collect();
+        // Misclassification counts front-lit pixels only: elsewhere shading darkens the
+        // surface whatever the map says (see metrics::FRONT_LIT_MIN_COS).
+        let truth_front_lit: Vec<Option<bool>> = truth
+            .lit
+            .iter()
+            .zip(&surfaces)
+            .map(|(t, s)| t.filter(|_| s.is_some_and(|s| metrics::is_front_lit(&config.light, &s))))
+            .collect();
+        let fixed = fixed_points(config, settings, &surfaces);
+        let scene_bounds = config
+            .scene
+            .scene_bounds()
+            .ok_or_else(|| EvalError::InvalidMesh {
+                message: format!("{}: scene has no bounds", config.scene.name),
+            })?;
+        Ok(Self {
+            frames,
+            truth_front_lit,
+            surfaces,
+            fixed,
+            scene_bounds,
+        })
+    }
+
+    fn context<'a>(&'a self, frame: &'a Frame, config: &'a Configuration) -> FrameContext<'a> {
+        FrameContext {
+            camera: &frame.camera,
+            light: &config.light,
+            scene: self.scene_bounds,
+            eye_samples: &frame.samples,
+            pixels_per_radian: frame.screen.pixels_per_radian().unwrap_or(1.0) as f32,
+        }
+    }
+}
+
+/// Fixed world points for the temporal measures: a regular subset of the front-lit
+/// points of frame 0 (on surfaces parallel to the light the shadow test is a coin
+/// toss that shading hides).
+fn fixed_points(
+    config: &Configuration,
+    settings: &Settings,
+    surfaces: &[Option<SurfacePoint>],
+) -> Vec<DVec3> {
+    let (w, h) = (settings.width, settings.height);
+    let stride = settings.temporal_stride.max(1) as usize;
+    (0..h)
+        .step_by(stride)
+        .flat_map(|y| (0..w).step_by(stride).map(move |x| (x, y)))
+        .filter_map(|(x, y)| surfaces[(y * w + x) as usize])
+        .filter(|s| metrics::is_front_lit(&config.light, s))
+        .map(|s| s.position)
+        .collect()
+}
+
+fn summarize(config: &Configuration, reference: &Reference) -> ConfigSummary {
+    let (near, far) = config
+        .camera()
+        .depth_range()
+        .map(|(n, f)| (f64::from(n), f64::from(f)))
+        .unwrap_or((f64::NAN, f64::NAN));
+    ConfigSummary {
+        name: config.name.clone(),
+        description: config.description.clone(),
+        scene: config.scene.name.clone(),
+        light_kind: config.light_kind(),
+        depth_range: (near, far),
+        log_bound: metrics::log_bound(config.camera()),
+        visible_pixels: reference.frames[0].gbuffer.visible_count(),
+    }
+}
+
+/// Frame 0's measures of one technique, then its temporal measures along the path.
+fn measure(
+    kind: TechniqueKind,
+    config: &Configuration,
+    reference: &Reference,
+    setup: &Setup,
+) -> Result<Measured, EvalError> {
+    let first = &reference.frames[0];
+    let technique = Technique::build(kind, &reference.context(first, config), &setup.technique)?;
+    let (aliasing, pixels) = aliasing_stats(
+        &technique,
+        &technique.layer_sizes(),
+        &first.screen,
+        &config.light,
+        &reference.surfaces,
+    );
+    let map = technique.rasterize(&config.scene.mesh, &setup.raster)?;
+    let mask = ShadowMask::from_map(&first.gbuffer, &technique, &map, LOOKUP_BIAS);
+    let miss = misclassification(&mask.lit, &reference.truth_front_lit);
+    let (phase_jitter, flip_rate) = temporal(kind, config, reference, setup, &technique, &map);
+    Ok(Measured {
+        metrics: RowMetrics {
+            layers: technique.layers(),
+            layer_side: technique.layer_sizes().first().map_or(0, |s| s.0),
+            texels: technique.texels(),
+            aliasing,
+            misclassification: miss,
+            phase_jitter,
+            flip_rate,
+        },
+        m: pixels.m,
+        lit: mask.lit,
+    })
+}
+
+/// Refits the technique to every frame of the path and follows the fixed points:
+/// (phase jitter, flip rate), `None` when a frame cannot be fitted or rasterized.
+fn temporal(
+    kind: TechniqueKind,
+    config: &Configuration,
+    reference: &Reference,
+    setup: &Setup,
+    technique: &Technique,
+    map: &DepthMap,
+) -> (Option<f64>, Option<f64>) {
+    let fixed = &reference.fixed;
+    let mut texels = vec![texels_of(technique, fixed)];
+    let mut lit = vec![lit_of(technique, map, fixed)];
+    for f in &reference.frames[1..] {
+        let Ok(t) = Technique::build(kind, &reference.context(f, config), &setup.technique) else {
+            return (None, None);
+        };
+        let Ok(m) = t.rasterize(&config.scene.mesh, &setup.raster) else {
+            return (None, None);
+        };
+        texels.push(texels_of(&t, fixed));
+        lit.push(lit_of(&t, &m, fixed));
+    }
+    (phase_jitter(&texels), flip_rate(&lit))
+}
+
+fn texels_of(t: &Technique, points: &[DVec3]) -> Vec<Option<(DVec2, u32)>> {
+    let sizes = t.layer_sizes();
+    points
+        .iter()
+        .map(|&p| {
+            let s = t.map_point(p)?;
+            let (w, h) = *sizes.get(s.layer as usize)?;
+            Some((s.uv * DVec2::new(f64::from(w), f64::from(h)), s.layer))
+        })
+        .collect()
+}
+
+fn lit_of(t: &Technique, map: &DepthMap, points: &[DVec3]) -> Vec<Option<bool>> {
+    points
+        .iter()
+        .map(|&p| t.map_point(p).and_then(|s| map.is_lit(&s, LOOKUP_BIAS)))
+        .collect()
+}

@@ -1,0 +1,233 @@
+//! The runner: builds the configurations, shares one BVH per scene, evaluates the
+//! configurations on worker threads and merges their outputs in order.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+use crate::EvalError;
+use crate::bvh::Bvh;
+use crate::config::{
+    ConfigOptions, Configuration, mesh_configuration, standard_configurations, sweep_configurations,
+};
+use crate::technique::TechniqueKind;
+
+use super::evaluate::{ConfigOutput, evaluate_config};
+use super::image::{legend_image, write_png};
+use super::output::Staging;
+use super::sweep::summarize;
+use super::text::{markdown, metrics_csv};
+use super::{Options, Report, Settings};
+
+/// Runs the comparison and writes the report into `options.out`.
+///
+/// The output is all or nothing: the files are written into a staging directory
+/// beside `options.out` and replace the previous report only when all of them are
+/// complete; on any error the previous report is left as it was.
+///
+/// # Errors
+/// [`EvalError::InvalidOption`] for zero threads; [`EvalError::Write`] (with the
+/// path and the reason) when `options.out` cannot be created or replaced, or a
+/// file cannot be written; the import errors for a
+/// bad `--mesh`, [`EvalError::UnusableMesh`] for one without area or too large for
+/// an `f32` camera; [`EvalError::InvalidView`] / [`EvalError::InvalidMesh`] for a
+/// configuration that cannot be traced. A technique that cannot be built is not an
+/// error: its row says "n/a (reason)".
+pub fn run(options: &Options) -> Result<Report, EvalError> {
+    if options.threads == 0 {
+        return Err(EvalError::InvalidOption {
+            message: "--threads must be at least 1".into(),
+        });
+    }
+    let settings = Settings::new(options.quick);
+    // Every input is checked before the first configuration is evaluated.
+    let configs = configurations(options, &settings)?;
+    let sweep_settings = Settings::sweep();
+    let sweep_configs = if options.sweep > 0 {
+        sweep_configurations(&config_options(options, &sweep_settings), options.sweep)?
+    } else {
+        Vec::new()
+    };
+    let staging = Staging::create(&options.out)?;
+    let outputs = evaluate_all(&configs, &settings, options, staging.path(), true)?;
+    let sweep_outputs = evaluate_all(
+        &sweep_configs,
+        &sweep_settings,
+        options,
+        staging.path(),
+        false,
+    )?;
+    let mut report = Report {
+        settings,
+        seed: options.seed,
+        configs: Vec::new(),
+        rows: Vec::new(),
+        files: Vec::new(),
+        sweep_configs: Vec::new(),
+        sweep: None,
+    };
+    for out in outputs {
+        report.configs.push(out.summary);
+        report.rows.extend(out.rows);
+        report.files.extend(out.files);
+    }
+    for out in sweep_outputs {
+        report.sweep_configs.push(out.summary);
+        report.rows.extend(out.rows);
+    }
+    if options.sweep > 0 {
+        report.sweep = Some(summarize(&report.sweep_configs, &report.rows));
+    }
+    write_report_files(&mut report, staging.path())?;
+    staging.commit()?;
+    Ok(report)
+}
+
+/// The standard configurations, plus the user mesh's.
+fn configurations(options: &Options, settings: &Settings) -> Result<Vec<Configuration>, EvalError> {
+    let config_options = config_options(options, settings);
+    let mut configs = standard_configurations(&config_options)?;
+    if let Some(path) = &options.mesh {
+        configs.push(user_mesh_configuration(path, &config_options)?);
+    }
+    Ok(configs)
+}
+
+/// The configuration of a user mesh; every error names the file.
+fn user_mesh_configuration(
+    path: &Path,
+    config_options: &ConfigOptions,
+) -> Result<Configuration, EvalError> {
+    let mesh = crate::import::load_mesh(path)?;
+    let unusable = |message: String| EvalError::UnusableMesh {
+        path: path.to_path_buf(),
+        message,
+    };
+    let area: f64 = mesh
+        .triangles()
+        .map(|[a, b, c]| 0.5 * (b - a).cross(c - a).length())
+        .sum();
+    if !(area > 0.0) {
+        return Err(unusable(format!(
+            "all {} triangle(s) have zero area: nothing casts or receives a shadow",
+            mesh.triangle_count()
+        )));
+    }
+    let name = path
+        .file_stem()
+        .map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());
+    let extent = mesh.bounds().map_or_else(String::new, |b| {
+        let v = |p: glam::Vec3| format!("({:.3e}, {:.3e}, {:.3e})", p.x, p.y, p.z);
+        format!(" (bounds {} to {})", v(b.min), v(b.max))
+    });
+    mesh_configuration(&name, mesh, config_options).map_err(|e| match e {
+        EvalError::InvalidMesh { message } | EvalError::InvalidView { message } => {
+            unusable(format!("cannot frame it{extent} with a camera: {message}"))
+        }
+        other => other,
+    })
+}
+
+fn config_options(options: &Options, settings: &Settings) -> ConfigOptions {
+    ConfigOptions::default()
+        .with_seed(options.seed)
+        .with_path_frames(settings.path_frames)
+        .with_aspect(settings.width as f32 / settings.height as f32)
+}
+
+/// One BVH per distinct scene, in configuration order.
+fn scene_bvhs(configs: &[Configuration]) -> Result<Vec<Arc<Bvh>>, EvalError> {
+    let mut bvhs: Vec<(*const crate::scene::Scene, Arc<Bvh>)> = Vec::new();
+    let mut config_bvh = Vec::new();
+    for c in configs {
+        let key = Arc::as_ptr(&c.scene);
+        let bvh = if let Some((_, b)) = bvhs.iter().find(|(k, _)| *k == key) {
+            Arc::clone(b)
+        } else {
+            let b = Arc::new(Bvh::build(&c.scene.mesh)?);
+            bvhs.push((key, Arc::clone(&b)));
+            b
+        };
+        config_bvh.push(bvh);
+    }
+    Ok(config_bvh)
+}
+
+fn progress_bar(configs: &[Configuration], show: bool) -> indicatif::ProgressBar {
+    if !show {
+        return indicatif::ProgressBar::hidden();
+    }
+    let units: usize = configs
+        .iter()
+        .map(|c| TechniqueKind::for_light(&c.light).len())
+        .sum();
+    indicatif::ProgressBar::with_draw_target(
+        Some(units as u64),
+        indicatif::ProgressDrawTarget::stderr(),
+    )
+}
+
+/// Evaluates every configuration on `options.threads` workers, writing pictures
+/// into `out` when `pictures`; the outputs come back in configuration order.
+fn evaluate_all(
+    configs: &[Configuration],
+    settings: &Settings,
+    options: &Options,
+    out: &Path,
+    pictures: bool,
+) -> Result<Vec<ConfigOutput>, EvalError> {
+    let config_bvh = scene_bvhs(configs)?;
+    let bar = progress_bar(configs, options.progress);
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<Result<ConfigOutput, EvalError>>>> =
+        Mutex::new((0..configs.len()).map(|_| None).collect());
+    let threads = options.threads.clamp(1, configs.len().max(1));
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(config) = configs.get(i) else { break };
+                    let pictures = pictures.then_some(out);
+                    let output = evaluate_config(config, &config_bvh[i], settings, pictures, &bar);
+                    if let Ok(mut r) = results.lock() {
+                        r[i] = Some(output);
+                    }
+                }
+            });
+        }
+    });
+    bar.finish_and_clear();
+    results
+        .into_inner()
+        .unwrap_or_default()
+        .into_iter()
+        .map(|r| {
+            r.ok_or_else(|| EvalError::InvalidView {
+                message: "a worker thread stopped".into(),
+            })?
+        })
+        .collect()
+}
+
+/// Writes the legend, `metrics.csv` and `report.md`, and lists them in the report.
+fn write_report_files(report: &mut Report, out: &Path) -> Result<(), EvalError> {
+    let legend = PathBuf::from("legend.png");
+    write_png(&out.join(&legend), &legend_image())?;
+    report.files.push(legend);
+    let csv = PathBuf::from("metrics.csv");
+    write_file(&out.join(&csv), &metrics_csv(report))?;
+    report.files.push(csv);
+    let md = PathBuf::from("report.md");
+    report.files.push(md.clone());
+    report.files.sort();
+    write_file(&out.join(&md), &markdown(report))
+}
+
+pub(super) fn write_file(path: &Path, text: &str) -> Result<(), EvalError> {
+    let err = |source| EvalError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    std::fs::write(path, text.as_bytes()).map_err(err)
+}
