@@ -185,6 +185,7 @@
 //! | light inside the truncated frustum | dual fallback; [`fit_minimal_cone`]: [`ParaboloidError::NoConeUnder90`] |
 //! | degenerate frustum | [`ParaboloidError::DegenerateFrustum`], or the camera's error |
 //! | `near >= range`, `near <= 0` | [`ParaboloidError::InvalidDepthRange`] |
+//! | depth bounds with `min > max` | [`ParaboloidError::InvalidDepthBounds`] |
 //! | directional light | [`ParaboloidError::UnsupportedLight`] |
 //!
 //! # Features

@@ -164,7 +164,10 @@ impl IpsmPlan {
     /// [`ParaboloidError::NonFinite`] / [`ParaboloidError::InvalidOptions`] for bad
     /// options; [`ParaboloidError::InvalidDepthRange`] unless
     /// `0 < options.near < range`; [`ParaboloidError::DegenerateFrustum`] when the
-    /// border points (nearly) coincide.
+    /// border points (nearly) coincide; [`ParaboloidError::NonFinite`] for NaN bounds
+    /// and [`ParaboloidError::InvalidDepthBounds`] for `bounds.min > bounds.max`
+    /// (infinite bounds and bounds outside the camera's range are clamped to it, equal
+    /// ones give the camera's range).
     pub fn new(
         light: &Light,
         camera: &Camera,
@@ -181,6 +184,13 @@ impl IpsmPlan {
         };
         camera.validate()?;
         let (lo, hi) = match bounds {
+            Some(b) if b.min.is_nan() || b.max.is_nan() => return Err(ParaboloidError::NonFinite),
+            Some(b) if b.min > b.max => {
+                return Err(ParaboloidError::InvalidDepthBounds {
+                    min: b.min,
+                    max: b.max,
+                });
+            }
             Some(b) => b.clamped_to(camera)?,
             None => camera.depth_range()?,
         };
@@ -464,11 +474,41 @@ mod tests {
             IpsmPlan::new(&light, &camera(), None, &IpsmOptions::default()),
             Err(ParaboloidError::UnsupportedLight)
         );
+        let point = Light::Point {
+            position: Vec3::new(0.0, 50.0, -50.0),
+            range: 500.0,
+        };
         let p = [Vec3::ONE; 8];
         assert_eq!(
             IpsmPlan::from_points(Vec3::ZERO, 10.0, &p, Vec3::NEG_Z, &IpsmOptions::default()),
             Err(ParaboloidError::DegenerateFrustum)
         );
+        let swapped = DepthBounds {
+            min: 40.0,
+            max: 5.0,
+        };
+        assert_eq!(
+            IpsmPlan::new(&point, &camera(), Some(swapped), &IpsmOptions::default()),
+            Err(ParaboloidError::InvalidDepthBounds {
+                min: 40.0,
+                max: 5.0
+            })
+        );
+        let nan = DepthBounds {
+            min: f32::NAN,
+            max: 5.0,
+        };
+        assert_eq!(
+            IpsmPlan::new(&point, &camera(), Some(nan), &IpsmOptions::default()),
+            Err(ParaboloidError::NonFinite)
+        );
+        // Ordered bounds are accepted and truncate the frustum.
+        let ordered = DepthBounds {
+            min: 5.0,
+            max: 40.0,
+        };
+        let plan = IpsmPlan::new(&point, &camera(), Some(ordered), &IpsmOptions::default());
+        assert_eq!(plan.map(|p| p.depth_range), Ok((5.0, 40.0)));
         let o = IpsmOptions::default().with_margin(-1.0);
         let f = camera().slice(1.0, 10.0).unwrap();
         assert_eq!(
