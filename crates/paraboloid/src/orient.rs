@@ -32,15 +32,26 @@ const SAMPLES: usize = 15;
 #[derive(Clone, Copy)]
 pub(crate) struct Sample {
     v: DVec3,
+    length: f64,
     inv_size: f64,
 }
 
 /// The predicted largest texel-to-pixel ratio of a dual map with axis `a` (unit).
+#[cfg(test)]
 pub(crate) fn cost(a: DVec3, samples: &[Sample]) -> f64 {
-    samples
-        .iter()
-        .map(|s| (s.v.length() + a.dot(s.v).abs()) * s.inv_size)
-        .fold(0.0, f64::max)
+    cost_below(a, samples, f64::INFINITY)
+}
+
+/// `cost`, stopping early (with some value `>= limit`) once it reaches `limit`.
+fn cost_below(a: DVec3, samples: &[Sample], limit: f64) -> f64 {
+    let mut c = 0.0f64;
+    for s in samples {
+        c = c.max((s.length + a.dot(s.v).abs()) * s.inv_size);
+        if c >= limit {
+            break;
+        }
+    }
+    c
 }
 
 /// Sample points of the truncated frustum with corners `pts` (near then far).
@@ -64,8 +75,13 @@ pub(crate) fn samples(l: DVec3, pts: &[DVec3; 8]) -> ArrayVec<Sample, SAMPLES> {
         for p in quad.into_iter().chain([centre]) {
             let v = p - l;
             let inv_size = 1.0 / size;
-            if v.is_finite() && inv_size.is_finite() && v.length() > floor {
-                out.push(Sample { v, inv_size });
+            let length = v.length();
+            if v.is_finite() && inv_size.is_finite() && length > floor {
+                out.push(Sample {
+                    v,
+                    length,
+                    inv_size,
+                });
             }
         }
     }
@@ -90,7 +106,8 @@ pub(crate) fn dual_axis(
         let Some(a) = a.try_normalize() else {
             return;
         };
-        let c = cost(a, &samples);
+        // The running maximum only grows: stop once it cannot win.
+        let c = cost_below(a, &samples, best_cost);
         if c < best_cost {
             best_cost = c;
             best = a;
