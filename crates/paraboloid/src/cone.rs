@@ -126,31 +126,38 @@ pub(crate) fn paper_fit(dirs: &[DVec3]) -> Option<DCone> {
     })
 }
 
-/// The minimum-norm point of the affine hull of 1, 2 or 3 points, if the set is
-/// not degenerate.
-fn affine_min_norm(points: &[DVec3]) -> Option<DVec3> {
-    match *points {
-        [a] => Some(a),
-        [a, b] => {
-            let e = b - a;
-            let ee = e.length_squared();
-            (ee > 1e-300).then(|| a + e * (-a.dot(e) / ee))
-        }
-        [a, b, c] => {
-            // The point of the plane closest to the origin, from the plane's normal:
-            // well conditioned even for slivers, unlike the 2x2 Gram system.
-            let n = (b - a).cross(c - a);
-            let nn = n.length_squared();
-            let scale = (b - a).length_squared() * (c - a).length_squared();
-            (nn > 1e-30 * scale && nn > 1e-300).then(|| n * (n.dot(a) / nn))
-        }
-        _ => None,
-    }
-}
-
 /// Half-angles from here up count as "no cone under 90 degrees": `pi/2 - 1e-6`, so that
 /// the `f32` half-angle, rounded up, stays under 90 degrees.
 pub(crate) const NO_CONE_ANGLE: f64 = core::f64::consts::FRAC_PI_2 - 1e-6;
+
+/// The minimum-norm point of the plane through three unit directions (the
+/// circumcentre of their triangle) if it lies inside the triangle, else `None`.
+///
+/// From the plane's normal, well conditioned even for slivers. `p*` has strictly
+/// positive barycentric weights on its support set, so a triple whose point falls
+/// outside its triangle cannot support the minimal cone: this test skips most
+/// triples before scoring.
+fn triangle_min_norm(a: DVec3, b: DVec3, c: DVec3, best_cos: f64) -> Option<DVec3> {
+    let (e1, e2) = (b - a, c - a);
+    let n = e1.cross(e2);
+    let nn = n.length_squared();
+    let scale = e1.length_squared() * e2.length_squared();
+    if !(nn > 1e-30 * scale && nn > 1e-300) {
+        return None;
+    }
+    let na = n.dot(a);
+    // |p| = |n . a| / |n| is the cosine of the subset's own directions with the
+    // candidate axis, an upper bound of its score.
+    if na * na <= best_cos.max(0.0) * best_cos.abs() * nn {
+        return None;
+    }
+    let p = n * (na / nn);
+    let r = p - a;
+    let wb = r.cross(e2).dot(n) / nn;
+    let wc = e1.cross(r).dot(n) / nn;
+    let tol = -1e-9;
+    (wb >= tol && wc >= tol && 1.0 - wb - wc >= tol).then_some(p)
+}
 
 /// The exact minimal enclosing cone of unit directions, or `None` when no cone under
 /// 90 degrees contains them.
@@ -158,19 +165,21 @@ pub(crate) const NO_CONE_ANGLE: f64 = core::f64::consts::FRAC_PI_2 - 1e-6;
 /// The optimal axis is `p* / |p*|` with `p*` the minimum-norm point of the convex hull
 /// of the directions, and `cos(half_angle) = |p*|` (minimax duality). `p*` is the
 /// minimum-norm point of the affine hull of its support set (one, two or three
-/// directions: it lies on a face of the hull), so the axis is among the axes of the
-/// affine minimum-norm points of all subsets of size 1 to 3; the one with the largest
-/// smallest cosine is optimal. The paper's axis is a candidate too, so the result is
-/// never wider than the paper's cone.
+/// directions: it lies on a face of the hull, with positive barycentric weights), so
+/// the axis is among the axes of the affine minimum-norm points of all subsets of size
+/// 1 to 3 that fall inside their subset; the one with the largest smallest cosine is
+/// optimal. The paper's axis is a candidate too, so the result is never wider than
+/// the paper's cone. For unit directions the points are the directions themselves, the
+/// midpoints of pairs and the circumcentres of triangles; a subset's own directions
+/// have cosine `|p|` with its axis, an upper bound that skips a candidate before its
+/// `O(n)` scoring.
 pub(crate) fn minimal_fit(dirs: &[DVec3]) -> Option<DCone> {
     let n = dirs.len();
     let mut best_axis = DVec3::ZERO;
     let mut best_cos = f64::NEG_INFINITY;
-    let mut consider = |p: DVec3| {
+    let mut consider = |p: DVec3, best_cos: &mut f64| {
         let len = p.length();
-        // Every direction of the subset has `axis . d = |p|`, so `|p|` bounds the
-        // candidate's smallest cosine: skip candidates that cannot win.
-        if !(len > 1e-15 && len.is_finite()) || len <= best_cos {
+        if !(len > 1e-15 && len.is_finite()) {
             return;
         }
         let axis = p / len;
@@ -178,24 +187,33 @@ pub(crate) fn minimal_fit(dirs: &[DVec3]) -> Option<DCone> {
             .iter()
             .map(|&d| axis.dot(d))
             .fold(f64::INFINITY, f64::min);
-        if min_cos > best_cos {
-            best_cos = min_cos;
+        if min_cos > *best_cos {
+            *best_cos = min_cos;
             best_axis = axis;
         }
     };
     let sum: DVec3 = dirs.iter().copied().sum();
     if let Some(axis) = sum.try_normalize() {
-        consider(axis);
+        consider(axis, &mut best_cos);
+    }
+    // Singles, then pairs, then triples: the best cosine so far rises before the
+    // many triples are bounded against it.
+    for &d in dirs {
+        consider(d, &mut best_cos);
     }
     for i in 0..n {
-        consider(dirs[i]);
         for j in i + 1..n {
-            if let Some(p) = affine_min_norm(&[dirs[i], dirs[j]]) {
-                consider(p);
+            let mid = dirs[i] + dirs[j];
+            if 0.5 * mid.length() > best_cos {
+                consider(mid, &mut best_cos);
             }
+        }
+    }
+    for i in 0..n {
+        for j in i + 1..n {
             for k in j + 1..n {
-                if let Some(p) = affine_min_norm(&[dirs[i], dirs[j], dirs[k]]) {
-                    consider(p);
+                if let Some(p) = triangle_min_norm(dirs[i], dirs[j], dirs[k], best_cos) {
+                    consider(p, &mut best_cos);
                 }
             }
         }

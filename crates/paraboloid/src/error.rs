@@ -34,6 +34,13 @@ pub enum ParaboloidError {
         /// The far distance given.
         far: f32,
     },
+    /// Measured depth bounds with `min > max` (a near hint beyond the far hint).
+    InvalidDepthBounds {
+        /// The minimum view depth given.
+        min: f32,
+        /// The maximum view depth given.
+        max: f32,
+    },
     /// No directions, or more than [`MAX_CONE_DIRECTIONS`](crate::MAX_CONE_DIRECTIONS).
     InvalidDirectionCount,
     /// An option out of range (negative or non-finite margin, a largest single
@@ -69,6 +76,9 @@ impl fmt::Display for ParaboloidError {
             Self::DegenerateFrustum => f.write_str("truncated frustum has no extent"),
             Self::InvalidDepthRange { near, far } => {
                 write!(f, "invalid light depth range: near = {near}, far = {far}")
+            }
+            Self::InvalidDepthBounds { min, max } => {
+                write!(f, "depth bounds with min = {min} > max = {max}")
             }
             Self::InvalidDirectionCount => f.write_str("no directions, or too many"),
             Self::InvalidOptions => f.write_str("option out of range"),

@@ -167,7 +167,8 @@ impl ParaboloidMap {
     ///
     /// # Errors
     /// As [`ParaboloidMap::dual`], and [`ParaboloidError::InvalidZoom`] for a
-    /// half-angle outside `(0, pi/2]`.
+    /// half-angle outside `(0, pi/2]` (`pi/2` as `f32`, `std::f32::consts::FRAC_PI_2`,
+    /// included: it gives zoom 1).
     pub fn single(
         position: Vec3,
         axis: Vec3,
@@ -179,10 +180,12 @@ impl ParaboloidMap {
         if !half_angle.is_finite() {
             return Err(ParaboloidError::NonFinite);
         }
-        let h = f64::from(half_angle);
-        if !(h > 0.0 && h <= core::f64::consts::FRAC_PI_2) {
+        // Compared in `f32`: `f32::consts::FRAC_PI_2` rounds above the `f64` value, and
+        // the caller's pi/2 must be accepted; the cut is then exactly the hemisphere.
+        if !(half_angle > 0.0 && half_angle <= core::f32::consts::FRAC_PI_2) {
             return Err(ParaboloidError::InvalidZoom);
         }
+        let h = f64::from(half_angle).min(core::f64::consts::FRAC_PI_2);
         let zoom = zoom_for_half_angle(h);
         Self::build(
             position,
@@ -592,5 +595,34 @@ mod tests {
             ParaboloidMap::dual(Vec3::NAN, Vec3::X, 0.1, 1.0, &o),
             Err(ParaboloidError::NonFinite)
         );
+        assert_eq!(
+            ParaboloidMap::single(Vec3::ZERO, Vec3::X, 0.0, 0.1, 1.0, &o),
+            Err(ParaboloidError::InvalidZoom)
+        );
+        let above = f32::from_bits(core::f32::consts::FRAC_PI_2.to_bits() + 1);
+        assert_eq!(
+            ParaboloidMap::single(Vec3::ZERO, Vec3::X, above, 0.1, 1.0, &o),
+            Err(ParaboloidError::InvalidZoom)
+        );
+    }
+
+    #[test]
+    fn half_angle_pi_over_2_in_f32_is_the_whole_hemisphere() {
+        // f32 pi/2 rounds above f64 pi/2; the documented range (0, pi/2] includes it.
+        assert!(f64::from(core::f32::consts::FRAC_PI_2) > core::f64::consts::FRAC_PI_2);
+        let m = ParaboloidMap::single(
+            Vec3::ZERO,
+            Vec3::NEG_Z,
+            core::f32::consts::FRAC_PI_2,
+            0.1,
+            10.0,
+            &MapOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(m.zoom, 1.0);
+        assert_eq!(m.mode, ParaboloidMode::Single);
+        // A direction 90 degrees off the axis lands on the rim of the texture.
+        let s = m.project(Vec3::new(0.0, 5.0, 0.0), Side::Front).unwrap();
+        assert!(((s.uv - DVec2::splat(0.5)).length() - 0.5).abs() < 1e-6);
     }
 }

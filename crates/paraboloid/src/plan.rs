@@ -8,6 +8,7 @@ use crate::cone::{
     Cone, ConeFit, DCone, MIN_ZOOM, minimal_fit, paper_fit, round_up_f32, zoom_for_half_angle,
 };
 use crate::map::{MapOptions, ParaboloidMap, ParaboloidMode, Side, check_depth_range};
+use crate::orient::dual_axis;
 
 /// Knobs of [`IpsmPlan`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -121,7 +122,13 @@ pub enum DualReason {
 /// 4. the cut `zoom = tan(half_angle / 2)`;
 ///
 /// and the decision: one paraboloid when the cone's half-angle is under
-/// [`IpsmOptions::max_single_half_angle`], else a regular DPSM turned toward the view.
+/// [`IpsmOptions::max_single_half_angle`], else a regular DPSM with its seam through
+/// the view.
+///
+/// The dual map is not turned toward the view as the paper suggests: a paraboloid's
+/// texels are sparsest along its axis (half the linear density of its rim), so the
+/// plan picks the axis whose seam carries the view (see the crate docs, "The dual
+/// fallback").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IpsmPlan {
     /// The map to render (single or dual) and to look up.
@@ -146,8 +153,10 @@ impl IpsmPlan {
     ///
     /// Documented fallbacks (a dual map, see [`IpsmPlan::dual_reason`]): light inside
     /// the truncated frustum or on one of its border points, cancelling directions
-    /// (paper fit), a cone too wide for one paraboloid. The dual map's front faces the
-    /// fitted axis, else the averaged direction, else the camera's forward direction.
+    /// (paper fit), a cone too wide for one paraboloid. The dual map's axis minimizes
+    /// the largest predicted texel-to-pixel ratio over the truncated frustum (the
+    /// view's directions near the seam, where a paraboloid is densest), its front on
+    /// the side of the frustum's centroid; the up hint's axis is kept on ties.
     ///
     /// # Errors
     /// [`ParaboloidError::Frustum`] for an invalid light or camera;
@@ -155,7 +164,10 @@ impl IpsmPlan {
     /// [`ParaboloidError::NonFinite`] / [`ParaboloidError::InvalidOptions`] for bad
     /// options; [`ParaboloidError::InvalidDepthRange`] unless
     /// `0 < options.near < range`; [`ParaboloidError::DegenerateFrustum`] when the
-    /// border points (nearly) coincide.
+    /// border points (nearly) coincide; [`ParaboloidError::NonFinite`] for NaN bounds
+    /// and [`ParaboloidError::InvalidDepthBounds`] for `bounds.min > bounds.max`
+    /// (infinite bounds and bounds outside the camera's range are clamped to it, equal
+    /// ones give the camera's range).
     pub fn new(
         light: &Light,
         camera: &Camera,
@@ -172,6 +184,13 @@ impl IpsmPlan {
         };
         camera.validate()?;
         let (lo, hi) = match bounds {
+            Some(b) if b.min.is_nan() || b.max.is_nan() => return Err(ParaboloidError::NonFinite),
+            Some(b) if b.min > b.max => {
+                return Err(ParaboloidError::InvalidDepthBounds {
+                    min: b.min,
+                    max: b.max,
+                });
+            }
             Some(b) => b.clamped_to(camera)?,
             None => camera.depth_range()?,
         };
@@ -220,6 +239,11 @@ impl IpsmPlan {
                 v / len
             }
         });
+        let up_hint = options
+            .up_hint
+            .as_dvec3()
+            .try_normalize()
+            .unwrap_or(DVec3::ZERO);
         let map_options = MapOptions::default()
             .with_up_hint(options.up_hint)
             .with_reversed_z(options.reversed_z);
@@ -255,14 +279,10 @@ impl IpsmPlan {
             (None, Some(c)) if c.half_angle + margin >= max_single => Some(DualReason::ConeTooWide),
             (r, _) => r,
         };
-        let axis = cone
-            .map(|c| c.axis)
-            .or_else(|| paper_fit(&dirs).map(|c| c.axis).filter(|_| !on_point))
-            .unwrap_or(fallback_axis);
         let map = match (reason, cone) {
             (None, Some(c)) => ParaboloidMap::build(
                 light_position,
-                axis.as_vec3(),
+                c.axis.as_vec3(),
                 options.near,
                 range,
                 zoom_for_half_angle(c.half_angle + margin),
@@ -271,7 +291,7 @@ impl IpsmPlan {
             )?,
             _ => ParaboloidMap::build(
                 light_position,
-                axis.as_vec3(),
+                dual_axis(l, &pts, up_hint, fallback_axis, fallback_axis).as_vec3(),
                 options.near,
                 range,
                 1.0,
@@ -410,6 +430,28 @@ mod tests {
     }
 
     #[test]
+    fn dual_fallback_puts_the_view_on_the_seam() {
+        // A light inside the view, ahead of and above the camera.
+        let light = Light::Point {
+            position: Vec3::new(3.0, 8.0, -40.0),
+            range: 500.0,
+        };
+        let cam = camera();
+        let plan = IpsmPlan::new(&light, &cam, None, &IpsmOptions::default()).unwrap();
+        assert!(!plan.is_single());
+        let l = DVec3::new(3.0, 8.0, -40.0);
+        let pts = cam.slice(0.1, 100.0).unwrap().corners.map(Vec3::as_dvec3);
+        let samples = crate::orient::samples(l, &pts);
+        let cost = |a: DVec3| crate::orient::cost(a, &samples);
+        let chosen = cost(plan.map.axis().as_dvec3());
+        // Never worse than a DPSM facing down (the up hint's axis) ...
+        assert!(chosen <= cost(DVec3::Y) * (1.0 + 1e-6));
+        // ... and clearly better than facing the view's centroid (the paper's turn).
+        let centroid = pts.iter().copied().sum::<DVec3>() / 8.0;
+        assert!(chosen < 0.9 * cost((centroid - l).normalize()));
+    }
+
+    #[test]
     fn light_on_a_corner_falls_back_to_dual() {
         let f = camera().slice(1.0, 10.0).unwrap();
         let plan = IpsmPlan::from_points(
@@ -432,11 +474,41 @@ mod tests {
             IpsmPlan::new(&light, &camera(), None, &IpsmOptions::default()),
             Err(ParaboloidError::UnsupportedLight)
         );
+        let point = Light::Point {
+            position: Vec3::new(0.0, 50.0, -50.0),
+            range: 500.0,
+        };
         let p = [Vec3::ONE; 8];
         assert_eq!(
             IpsmPlan::from_points(Vec3::ZERO, 10.0, &p, Vec3::NEG_Z, &IpsmOptions::default()),
             Err(ParaboloidError::DegenerateFrustum)
         );
+        let swapped = DepthBounds {
+            min: 40.0,
+            max: 5.0,
+        };
+        assert_eq!(
+            IpsmPlan::new(&point, &camera(), Some(swapped), &IpsmOptions::default()),
+            Err(ParaboloidError::InvalidDepthBounds {
+                min: 40.0,
+                max: 5.0
+            })
+        );
+        let nan = DepthBounds {
+            min: f32::NAN,
+            max: 5.0,
+        };
+        assert_eq!(
+            IpsmPlan::new(&point, &camera(), Some(nan), &IpsmOptions::default()),
+            Err(ParaboloidError::NonFinite)
+        );
+        // Ordered bounds are accepted and truncate the frustum.
+        let ordered = DepthBounds {
+            min: 5.0,
+            max: 40.0,
+        };
+        let plan = IpsmPlan::new(&point, &camera(), Some(ordered), &IpsmOptions::default());
+        assert_eq!(plan.map(|p| p.depth_range), Ok((5.0, 40.0)));
         let o = IpsmOptions::default().with_margin(-1.0);
         let f = camera().slice(1.0, 10.0).unwrap();
         assert_eq!(

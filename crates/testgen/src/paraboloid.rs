@@ -163,14 +163,21 @@ pub fn plan_input_raw(u: &mut Unstructured<'_>) -> GenResult<PlanInput> {
     Ok(input)
 }
 
-/// Runs [`IpsmPlan::new`] and checks the contract: an `Ok` plan is finite, its zoom in
+/// Runs [`IpsmPlan::new`] and checks the contract: bounds with `min > max` are refused;
+/// an `Ok` plan is finite, its zoom in
 /// `(0, 1]`, dual exactly when it gives a reason, every border point covered by the
 /// fitted cone and, for a single map, mapped inside the usable disc.
 ///
 /// # Errors
 /// A description of the violated clause.
 pub fn check_plan(input: &PlanInput) -> Result<(), String> {
-    let plan = match IpsmPlan::new(&input.light, &input.camera, input.bounds, &input.options) {
+    let result = IpsmPlan::new(&input.light, &input.camera, input.bounds, &input.options);
+    if let Some(b) = input.bounds {
+        if b.min > b.max && result.is_ok() {
+            return Err(format!("bounds {b:?} with min > max accepted"));
+        }
+    }
+    let plan = match result {
         Ok(p) => p,
         Err(_) => return Ok(()),
     };
