@@ -151,7 +151,7 @@ impl Camera {
     /// # Errors
     /// As [`Camera::validate`].
     pub fn view_from_world(&self) -> Result<Mat4, FrustumError> {
-        Ok(self.geometry()?.world_from_view.inverse().as_mat4())
+        Ok(self.geometry()?.view_from_world().as_mat4())
     }
 
     /// Camera position in world space.
@@ -242,7 +242,7 @@ impl Camera {
     /// # Errors
     /// As [`Camera::validate`].
     pub fn clip_from_world(&self) -> Result<Mat4, FrustumError> {
-        let view_from_world = self.geometry()?.world_from_view.inverse();
+        let view_from_world = self.geometry()?.view_from_world();
         let clip_from_view = self.clip_from_view()?.as_dmat4();
         let m = (clip_from_view * view_from_world).as_mat4();
         // Far from the origin with a tiny near plane, f32 cannot tell the depth row
@@ -485,8 +485,9 @@ impl CameraGeometry {
         }
         let rounded = corners.map(|c| c.as_vec3().as_dvec3());
         dplanes(&rounded, f32_min_distance(&rounded))?;
-        // ...and every builder's own construction of it must succeed too.
-        Frustum::from_dcorners(&corners)?;
+        // ...and every builder's own construction of it must succeed too (the `f32`
+        // corners are finite, checked above).
+        dplanes(&corners, 0.0)?;
         Ok(geometry)
     }
 
@@ -562,6 +563,24 @@ impl CameraGeometry {
             }
         }
         Ok((near, far, origin, dir))
+    }
+
+    /// The inverse of the (orthonormal) pose: the transposed rotation and the
+    /// rotated, negated eye, exact where a general inverse would round.
+    pub(crate) fn view_from_world(&self) -> DMat4 {
+        let m = &self.world_from_view;
+        let (x, y, z) = (
+            m.x_axis.truncate(),
+            m.y_axis.truncate(),
+            m.z_axis.truncate(),
+        );
+        let eye = m.w_axis.truncate();
+        DMat4::from_cols(
+            DVec4::new(x.x, y.x, z.x, 0.0),
+            DVec4::new(x.y, y.y, z.y, 0.0),
+            DVec4::new(x.z, y.z, z.z, 0.0),
+            DVec4::new(-x.dot(eye), -y.dot(eye), -z.dot(eye), 1.0),
+        )
     }
 
     /// Clamps and checks a requested slice against the camera's range.
@@ -691,7 +710,7 @@ pub(crate) fn dplanes(
     let centroid = corners.iter().fold(DVec3::ZERO, |s, c| s + *c) / 8.0;
     let scale = corners
         .iter()
-        .map(|c| (*c - centroid).length())
+        .map(|c| (*c - centroid).length_squared())
         .fold(0.0, f64::max);
     if !(scale > 0.0 && scale.is_finite()) {
         return Err(FrustumError::DegenerateFrustum);
