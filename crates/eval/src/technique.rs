@@ -9,7 +9,7 @@
 //!
 //! | light | techniques |
 //! |---|---|
-//! | directional | uniform focused, stable cascades (PSSM, practical split), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), RTW (backward importance), RTW oracle |
+//! | directional | uniform focused, stable and tight cascades (PSSM over the depth bounds), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), RTW (backward importance), RTW oracle |
 //! | spot | spot fit |
 //! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone |
 //!
@@ -21,7 +21,7 @@
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap_frustum::{
-    Camera, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light, SceneBounds,
+    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light, SceneBounds,
     ShadowMapping, ShadowSample, ShadowTransform, SplitScheme, fit_spot,
 };
 use shadowmap_paraboloid::{
@@ -49,8 +49,13 @@ use crate::scene::Mesh;
 pub enum TechniqueKind {
     /// Orthographic fit of frustum ∩ receivers (`shadowmap_warp::uniform_focused`).
     UniformFocused,
-    /// PSSM: `CascadeSet::fit`, practical split, stable fit.
+    /// PSSM, stable: `CascadeSet::fit` with the stable fit clipped to the receivers on a
+    /// ladder of sizes; practical splits of the eye's depth bounds, cascade count from
+    /// their ratio (see [`cascade_splits`]).
     StableCascades,
+    /// PSSM, tight (SDSM-style): `CascadeSet::fit` with the tight fit to slice ∩
+    /// receivers over the same splits as [`TechniqueKind::StableCascades`].
+    TightCascades,
     /// Light space perspective shadow maps, `eta = 0`.
     Lispsm,
     /// Extended perspective shadow maps.
@@ -77,9 +82,10 @@ pub enum TechniqueKind {
 
 impl TechniqueKind {
     /// All techniques, in report order.
-    pub const ALL: [Self; 12] = [
+    pub const ALL: [Self; 13] = [
         Self::UniformFocused,
         Self::StableCascades,
+        Self::TightCascades,
         Self::Lispsm,
         Self::Xpsm,
         Self::Tsm,
@@ -98,6 +104,7 @@ impl TechniqueKind {
         match self {
             Self::UniformFocused => "uniform",
             Self::StableCascades => "cascades",
+            Self::TightCascades => "tight_cascades",
             Self::Lispsm => "lispsm",
             Self::Xpsm => "xpsm",
             Self::Tsm => "tsm",
@@ -119,6 +126,7 @@ impl TechniqueKind {
                 self,
                 Self::UniformFocused
                     | Self::StableCascades
+                    | Self::TightCascades
                     | Self::Lispsm
                     | Self::Xpsm
                     | Self::Tsm
@@ -322,7 +330,23 @@ impl Technique {
                     tsm(camera, direction, &focus, &TsmOptions::default()).map_err(|x| e(&x))?;
                 (Inner::Matrix(t.transform), 1, single)
             }
-            TechniqueKind::StableCascades | TechniqueKind::WarpedCascades => {
+            TechniqueKind::StableCascades | TechniqueKind::TightCascades => {
+                let splits =
+                    cascade_splits(camera, frame.eye_samples, options).map_err(|x| e(&x))?;
+                let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
+                let side = options.layer_side(layers);
+                let fit = CascadeOptions::default()
+                    .with_resolution(side)
+                    .with_scene(Some(frame.scene));
+                let fit = if kind == TechniqueKind::StableCascades {
+                    fit.with_stable_size_step(Some(STABLE_SIZE_STEP))
+                } else {
+                    fit.with_fit(CascadeFit::Tight)
+                };
+                let set = CascadeSet::fit(camera, direction, &splits, &fit).map_err(|x| e(&x))?;
+                (Inner::Cascades(Box::new(set)), layers, side)
+            }
+            TechniqueKind::WarpedCascades => {
                 let count = options.cascades;
                 let layers = u32::try_from(count).unwrap_or(u32::MAX);
                 let side = options.layer_side(layers);
@@ -337,48 +361,35 @@ impl Technique {
                 )
                 .and_then(|s| s.with_overlap(0.0))
                 .map_err(|x| e(&x))?;
-                if kind == TechniqueKind::StableCascades {
-                    let set = CascadeSet::fit(
-                        camera,
-                        direction,
-                        &splits,
-                        &CascadeOptions::default()
-                            .with_resolution(side)
-                            .with_scene(Some(frame.scene)),
-                    )
-                    .map_err(|x| e(&x))?;
-                    (Inner::Cascades(Box::new(set)), layers, side)
-                } else {
-                    let etas = vec![0.0; count];
-                    let w = warped_cascades(
-                        camera,
-                        direction,
-                        &focus,
-                        &splits,
-                        &etas,
-                        &LispsmOptions::default(),
-                    )
-                    .map_err(|x| e(&x))?;
-                    let cascades = w
-                        .cascades
-                        .iter()
-                        .map(|c| {
-                            (
-                                (f64::from(c.near), f64::from(c.far)),
-                                c.shadow.map(|s| s.transform),
-                            )
-                        })
-                        .collect();
-                    (
-                        Inner::Warped {
-                            eye: camera.eye().as_dvec3(),
-                            forward: camera.forward().as_dvec3(),
-                            cascades,
-                        },
-                        layers,
-                        side,
-                    )
-                }
+                let etas = vec![0.0; count];
+                let w = warped_cascades(
+                    camera,
+                    direction,
+                    &focus,
+                    &splits,
+                    &etas,
+                    &LispsmOptions::default(),
+                )
+                .map_err(|x| e(&x))?;
+                let cascades = w
+                    .cascades
+                    .iter()
+                    .map(|c| {
+                        (
+                            (f64::from(c.near), f64::from(c.far)),
+                            c.shadow.map(|s| s.transform),
+                        )
+                    })
+                    .collect();
+                (
+                    Inner::Warped {
+                        eye: camera.eye().as_dvec3(),
+                        forward: camera.forward().as_dvec3(),
+                        cascades,
+                    },
+                    layers,
+                    side,
+                )
             }
             TechniqueKind::Rtw | TechniqueKind::RtwOracle => {
                 let base = uniform_focused(camera, direction, &focus, &UniformOptions::default())
@@ -673,6 +684,44 @@ fn point_of(light: &Light) -> Option<(Vec3, f32)> {
     }
 }
 
+/// Ladder step of the stable cascades' sizes: a rung every half octave.
+const STABLE_SIZE_STEP: f32 = core::f32::consts::SQRT_2;
+
+/// Splits of the cascaded matrix techniques: practical splits of the eye's depth
+/// bounds (the camera's range without samples), so no cascade covers empty depth.
+/// The count follows the bounds' ratio `r = max / min`: with `k` maps sharing the
+/// budget, a logarithmic split leaves each cascade a depth ratio `r^(1/k)` on
+/// `side(k)` texels, so the count minimizing `r^(1/k) / side(k)` is taken, among the
+/// counts up to `options.cascades` whose side is a power of two when there are any
+/// (the stable fit's whole-texel motion is exact in `f32` only there).
+fn cascade_splits(
+    camera: &Camera,
+    samples: &[EyeSample],
+    options: &TechniqueOptions,
+) -> Result<CascadeSplits, shadowmap_frustum::FrustumError> {
+    let (near, far) = match depth_bounds(camera, samples) {
+        Some(bounds) => bounds.clamped_to(camera)?,
+        None => camera.depth_range()?,
+    };
+    let ratio = f64::from(far) / f64::from(near);
+    let max = options.cascades.clamp(1, shadowmap_frustum::MAX_CASCADES);
+    let power_of_two = |k: &usize| options.layer_side(*k as u32).is_power_of_two();
+    let any_power = (1..=max).any(|k| power_of_two(&k));
+    let cost = |k: usize| ratio.powf(1.0 / k as f64) / f64::from(options.layer_side(k as u32));
+    let count = (1..=max)
+        .filter(|k| !any_power || power_of_two(k))
+        .min_by(|a, b| cost(*a).total_cmp(&cost(*b)))
+        .unwrap_or(1);
+    CascadeSplits::new(
+        &SplitScheme::Practical {
+            lambda: options.split_lambda,
+        },
+        count,
+        near,
+        far,
+    )
+}
+
 /// Min/max view depth of the eye's samples (IPSM's truncated frustum), `None`
 /// without samples.
 fn depth_bounds(camera: &Camera, samples: &[EyeSample]) -> Option<DepthBounds> {
@@ -737,7 +786,7 @@ mod tests {
             position: Vec3::Y,
             range: 10.0,
         };
-        assert_eq!(TechniqueKind::for_light(&d).len(), 8);
+        assert_eq!(TechniqueKind::for_light(&d).len(), 9);
         assert_eq!(TechniqueKind::for_light(&p).len(), 3);
         assert!(!TechniqueKind::SpotFit.applies_to(&d));
     }
@@ -786,7 +835,10 @@ mod tests {
         };
         // (Stable cascades have a documented fallback instead: the whole slice.)
         for kind in TechniqueKind::for_light(&light) {
-            if kind == TechniqueKind::StableCascades {
+            if matches!(
+                kind,
+                TechniqueKind::StableCascades | TechniqueKind::TightCascades
+            ) {
                 assert!(Technique::build(kind, &frame, &o).is_ok());
                 continue;
             }

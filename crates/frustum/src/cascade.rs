@@ -51,6 +51,15 @@ pub struct CascadeOptions {
     pub up_hint: Vec3,
     /// Scene bounds for scene-dependent fitting.
     pub scene: Option<SceneBounds>,
+    /// Stable fit with scene bounds only. `None` (the default): every cascade is sized
+    /// by the bounding sphere of its whole slice. `Some(step)`, `step` in
+    /// `(1, 16]`: the box is fitted to the slice ∩ receivers and its side is
+    /// rounded up to the next power of `step` in world units, `step^ceil(log_step(s))`
+    /// for a needed side `s` (a stateless ladder of sizes). The size then stays fixed
+    /// while the needed side moves within one rung, so the texel grid keeps its
+    /// whole-texel motion, and it is never more than `step` times the needed side,
+    /// where the whole slice's sphere can be many times the visible receivers.
+    pub stable_size_step: Option<f32>,
 }
 
 impl Default for CascadeOptions {
@@ -61,6 +70,7 @@ impl Default for CascadeOptions {
             reversed_z: false,
             up_hint: Vec3::Y,
             scene: None,
+            stable_size_step: None,
         }
     }
 }
@@ -94,6 +104,13 @@ impl CascadeOptions {
     #[must_use]
     pub const fn with_scene(mut self, scene: Option<SceneBounds>) -> Self {
         self.scene = scene;
+        self
+    }
+    /// With this size ladder for the stable fit (see
+    /// [`CascadeOptions::stable_size_step`]).
+    #[must_use]
+    pub const fn with_stable_size_step(mut self, step: Option<f32>) -> Self {
+        self.stable_size_step = step;
         self
     }
 }
@@ -143,7 +160,9 @@ impl CascadeSet {
     /// Any error of [`Camera::validate`]; [`FrustumError::NonFinite`] or
     /// [`FrustumError::ZeroDirection`] for the light; [`FrustumError::InvalidResolution`];
     /// [`FrustumError::InvalidDepthRange`] if the splits leave the camera's range;
-    /// [`FrustumError::EmptyBounds`] / [`FrustumError::NonFinite`] for bad scene bounds.
+    /// [`FrustumError::EmptyBounds`] / [`FrustumError::NonFinite`] for bad scene bounds;
+    /// [`FrustumError::InvalidSplitParameter`] for a
+    /// [`CascadeOptions::stable_size_step`] outside `(1, 16]`.
     pub fn fit(
         camera: &Camera,
         light_direction: Vec3,
@@ -256,6 +275,11 @@ impl Fitter {
         if !(4..=MAX_RESOLUTION).contains(&options.resolution) {
             return Err(FrustumError::InvalidResolution);
         }
+        if let Some(step) = options.stable_size_step {
+            if !(step > 1.0 && step <= 16.0) {
+                return Err(FrustumError::InvalidSplitParameter);
+            }
+        }
         let scene = match options.scene {
             Some(s) => Some(SceneBounds {
                 receivers: s.receivers.validate()?,
@@ -284,6 +308,14 @@ impl Fitter {
             options: *options,
             scene,
         })
+    }
+
+    /// The stable size ladder's step, when it applies (stable fit with scene bounds).
+    fn ladder_step(&self) -> Option<f64> {
+        match (self.options.fit, &self.scene, self.options.stable_size_step) {
+            (CascadeFit::Stable, Some(_), Some(step)) => Some(f64::from(step)),
+            _ => None,
+        }
     }
 
     fn fit_without_receivers(&self, near: f32, far: f32) -> Result<Cascade, FrustumError> {
@@ -346,6 +378,10 @@ impl Fitter {
                 let (a, b) = (lo.truncate() - pad, hi.truncate() + pad);
                 (a, b, (b - a).max_element() / res)
             }
+            CascadeFit::Stable if self.ladder_step().is_some() => {
+                let step = self.ladder_step().unwrap_or(2.0);
+                ladder_box(lo.truncate(), hi.truncate(), step, res)?
+            }
             CascadeFit::Stable => {
                 let (center_view, radius) = bounding_sphere(&self.camera.view_corners(n, f));
                 let center = self.light_from_view.transform_point3(center_view);
@@ -405,6 +441,36 @@ impl Fitter {
             receivers_missed: false,
         })
     }
+}
+
+/// The stable box over the light-space footprint `[lo, hi]` with a ladder of sizes:
+/// side `step^ceil(log_step(s))` for the needed side `s` (the footprint's larger side
+/// plus one texel of slack on each side for the snap), centre snapped to whole texels.
+/// Returns the box and its texel size.
+fn ladder_box(
+    lo: DVec2,
+    hi: DVec2,
+    step: f64,
+    res: f64,
+) -> Result<(DVec2, DVec2, f64), FrustumError> {
+    let needed = (hi - lo).max_element() * res / (res - 2.0);
+    let scale = lo.abs().max(hi.abs()).max_element();
+    // A footprint seen edge-on still gets a box f32 can resolve around it.
+    let needed = needed.max(1e-5 * scale);
+    if !(needed > 0.0 && needed.is_finite()) {
+        return Err(FrustumError::EmptyBounds);
+    }
+    let rung = math::ceil(math::ln(needed) / math::ln(step));
+    let mut side = math::powf(step, rung);
+    // Rounding of the logarithm may land one rung low.
+    if side < needed {
+        side *= step;
+    }
+    let texel = side / (res - 2.0);
+    let center = (lo + hi) * 0.5;
+    let snapped = (center / texel).round() * texel;
+    let half = DVec2::splat(0.5 * res * texel);
+    Ok((snapped - half, snapped + half, texel))
 }
 
 /// Light-space distance range of the part of the caster box that lies over the

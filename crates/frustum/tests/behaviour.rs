@@ -637,3 +637,56 @@ fn spot_with_region_behind_it_is_outside_the_scene() {
         Err(FrustumError::SliceOutsideScene)
     );
 }
+
+/// The stable fit on a size ladder: fitted to slice ∩ receivers, so much smaller than
+/// the whole slice's sphere over a small receiver; the size stays on its rung while
+/// the camera moves a little, and the map moves by whole texels.
+#[test]
+fn stable_size_ladder_fits_receivers_and_keeps_its_size() {
+    let cam = camera();
+    let splits = CascadeSplits::new(&SplitScheme::Logarithmic, 2, 1.0, 1000.0).unwrap();
+    let ground = Aabb::new(Vec3::new(-5.0, -0.1, -60.0), Vec3::new(5.0, 0.0, -40.0));
+    let scene = SceneBounds {
+        receivers: ground,
+        casters: ground,
+    };
+    let light = Vec3::new(-0.3, -1.0, -0.2);
+    let whole = CascadeOptions::default()
+        .with_resolution(1024)
+        .with_scene(Some(scene));
+    let ladder = whole.with_stable_size_step(Some(std::f32::consts::SQRT_2));
+    let a = CascadeSet::fit(&cam, light, &splits, &whole).unwrap();
+    let b = CascadeSet::fit(&cam, light, &splits, &ladder).unwrap();
+    let (ta, tb) = (
+        a.cascades[1].texel_world_size,
+        b.cascades[1].texel_world_size,
+    );
+    assert!(tb < 0.2 * ta, "{tb} vs {ta}");
+    // Needed side at most 60 units (the receiver's diagonal): at most sqrt 2 more.
+    assert!(
+        tb * 1022.0 <= 60.0 * std::f32::consts::SQRT_2 * 1.001,
+        "{tb}"
+    );
+    let moved = Camera {
+        world_from_view: Mat4::from_translation(Vec3::new(0.01, 0.0, 0.0)) * cam.world_from_view,
+        ..cam
+    };
+    let c = CascadeSet::fit(&moved, light, &splits, &ladder).unwrap();
+    assert_eq!(c.cascades[1].texel_world_size, tb);
+    let p = Vec3::new(1.0, 0.0, -50.0);
+    let (sb, sc) = (
+        b.cascades[1].transform.project(p).unwrap(),
+        c.cascades[1].transform.project(p).unwrap(),
+    );
+    let texels = (sc.uv - sb.uv) * 1024.0;
+    assert!((texels - texels.round()).length() < 1e-3, "{texels}");
+    assert_eq!(
+        CascadeSet::fit(
+            &cam,
+            light,
+            &splits,
+            &whole.with_stable_size_step(Some(1.0))
+        ),
+        Err(FrustumError::InvalidSplitParameter)
+    );
+}
