@@ -203,7 +203,12 @@ pub fn cascade_case_raw(u: &mut Unstructured<'_>) -> GenResult<CascadeCase> {
         } else {
             any_vec3(u)?
         })
-        .with_scene(scene);
+        .with_scene(scene)
+        .with_stable_size_step(match u.int_in_range(0u8..=2)? {
+            0 => None,
+            1 => Some(in_range(u, 1.0001, 4.0)?),
+            _ => Some(any_f32(u)?),
+        });
     Ok(CascadeCase {
         camera,
         light,
