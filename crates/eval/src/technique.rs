@@ -9,7 +9,7 @@
 //!
 //! | light | techniques |
 //! |---|---|
-//! | directional | uniform focused, stable cascades (PSSM, practical split), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), auto (the candidate with the lowest predicted error), RTW (backward importance), RTW oracle |
+//! | directional | uniform focused, stable and tight cascades (PSSM over the depth bounds), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), auto (the candidate with the lowest predicted error), RTW (backward importance), RTW oracle |
 //! | spot | spot fit |
 //! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone |
 //!
@@ -21,9 +21,8 @@
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap_frustum::{
-    Camera, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light, PredictOptions,
-    SceneBounds, ShadowMapping, ShadowSample, ShadowTransform, SplitScheme, TechniqueSelector,
-    fit_spot, predict_error,
+    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light, SceneBounds,
+    ShadowMapping, ShadowSample, ShadowTransform, SplitScheme, fit_spot,
 };
 use shadowmap_paraboloid::{
     ConeFit, IpsmOptions, IpsmPlan, MapOptions, ParaboloidMap, Side, SubdivisionOptions,
@@ -46,13 +45,24 @@ use crate::raster::{
 };
 use crate::scene::Mesh;
 
+mod auto;
+#[cfg(test)]
+mod tests;
+
+pub use auto::AUTO_CANDIDATES;
+
 /// Every technique of the comparison.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum TechniqueKind {
     /// Orthographic fit of frustum ∩ receivers (`shadowmap_warp::uniform_focused`).
     UniformFocused,
-    /// PSSM: `CascadeSet::fit`, practical split, stable fit.
+    /// PSSM, stable: `CascadeSet::fit` with the stable fit clipped to the receivers on a
+    /// ladder of sizes; practical splits of the eye's depth bounds, cascade count from
+    /// their ratio (see [`cascade_splits`]).
     StableCascades,
+    /// PSSM, tight (SDSM-style): `CascadeSet::fit` with the tight fit to slice ∩
+    /// receivers over the same splits as [`TechniqueKind::StableCascades`].
+    TightCascades,
     /// Light space perspective shadow maps, `eta = 0`.
     Lispsm,
     /// Extended perspective shadow maps.
@@ -83,9 +93,10 @@ pub enum TechniqueKind {
 
 impl TechniqueKind {
     /// All techniques, in report order.
-    pub const ALL: [Self; 13] = [
+    pub const ALL: [Self; 14] = [
         Self::UniformFocused,
         Self::StableCascades,
+        Self::TightCascades,
         Self::Lispsm,
         Self::Xpsm,
         Self::Tsm,
@@ -105,6 +116,7 @@ impl TechniqueKind {
         match self {
             Self::UniformFocused => "uniform",
             Self::StableCascades => "cascades",
+            Self::TightCascades => "tight_cascades",
             Self::Lispsm => "lispsm",
             Self::Xpsm => "xpsm",
             Self::Tsm => "tsm",
@@ -127,6 +139,7 @@ impl TechniqueKind {
                 self,
                 Self::UniformFocused
                     | Self::StableCascades
+                    | Self::TightCascades
                     | Self::Lispsm
                     | Self::Xpsm
                     | Self::Tsm
@@ -255,17 +268,6 @@ enum Inner {
     },
 }
 
-/// The candidates of [`TechniqueKind::Auto`], from the most to the least preferred
-/// when predictions tie.
-pub const AUTO_CANDIDATES: [TechniqueKind; 6] = [
-    TechniqueKind::UniformFocused,
-    TechniqueKind::Lispsm,
-    TechniqueKind::Tsm,
-    TechniqueKind::Xpsm,
-    TechniqueKind::WarpedCascades,
-    TechniqueKind::StableCascades,
-];
-
 /// A technique fitted to one frame.
 pub struct Technique {
     kind: TechniqueKind,
@@ -348,7 +350,23 @@ impl Technique {
                     tsm(camera, direction, &focus, &TsmOptions::default()).map_err(|x| e(&x))?;
                 (Inner::Matrix(t.transform), 1, single)
             }
-            TechniqueKind::StableCascades | TechniqueKind::WarpedCascades => {
+            TechniqueKind::StableCascades | TechniqueKind::TightCascades => {
+                let splits =
+                    cascade_splits(camera, frame.eye_samples, options).map_err(|x| e(&x))?;
+                let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
+                let side = options.layer_side(layers);
+                let fit = CascadeOptions::default()
+                    .with_resolution(side)
+                    .with_scene(Some(frame.scene));
+                let fit = if kind == TechniqueKind::StableCascades {
+                    fit.with_stable_size_step(Some(STABLE_SIZE_STEP))
+                } else {
+                    fit.with_fit(CascadeFit::Tight)
+                };
+                let set = CascadeSet::fit(camera, direction, &splits, &fit).map_err(|x| e(&x))?;
+                (Inner::Cascades(Box::new(set)), layers, side)
+            }
+            TechniqueKind::WarpedCascades => {
                 let count = options.cascades;
                 let layers = u32::try_from(count).unwrap_or(u32::MAX);
                 let side = options.layer_side(layers);
@@ -363,48 +381,35 @@ impl Technique {
                 )
                 .and_then(|s| s.with_overlap(0.0))
                 .map_err(|x| e(&x))?;
-                if kind == TechniqueKind::StableCascades {
-                    let set = CascadeSet::fit(
-                        camera,
-                        direction,
-                        &splits,
-                        &CascadeOptions::default()
-                            .with_resolution(side)
-                            .with_scene(Some(frame.scene)),
-                    )
-                    .map_err(|x| e(&x))?;
-                    (Inner::Cascades(Box::new(set)), layers, side)
-                } else {
-                    let etas = vec![0.0; count];
-                    let w = warped_cascades(
-                        camera,
-                        direction,
-                        &focus,
-                        &splits,
-                        &etas,
-                        &LispsmOptions::default(),
-                    )
-                    .map_err(|x| e(&x))?;
-                    let cascades = w
-                        .cascades
-                        .iter()
-                        .map(|c| {
-                            (
-                                (f64::from(c.near), f64::from(c.far)),
-                                c.shadow.map(|s| s.transform),
-                            )
-                        })
-                        .collect();
-                    (
-                        Inner::Warped {
-                            eye: camera.eye().as_dvec3(),
-                            forward: camera.forward().as_dvec3(),
-                            cascades,
-                        },
-                        layers,
-                        side,
-                    )
-                }
+                let etas = vec![0.0; count];
+                let w = warped_cascades(
+                    camera,
+                    direction,
+                    &focus,
+                    &splits,
+                    &etas,
+                    &LispsmOptions::default(),
+                )
+                .map_err(|x| e(&x))?;
+                let cascades = w
+                    .cascades
+                    .iter()
+                    .map(|c| {
+                        (
+                            (f64::from(c.near), f64::from(c.far)),
+                            c.shadow.map(|s| s.transform),
+                        )
+                    })
+                    .collect();
+                (
+                    Inner::Warped {
+                        eye: camera.eye().as_dvec3(),
+                        forward: camera.forward().as_dvec3(),
+                        cascades,
+                    },
+                    layers,
+                    side,
+                )
             }
             TechniqueKind::Auto => return Self::build_auto(frame, options),
             TechniqueKind::Rtw | TechniqueKind::RtwOracle => {
@@ -502,42 +507,6 @@ impl Technique {
             inner,
             layers,
             side,
-        })
-    }
-
-    /// `auto`: fits every candidate, predicts each one's 95th-percentile aliasing
-    /// error with the receivers' box standing in for the surfaces, and keeps the
-    /// lowest. The report fits each frame on its own, so the selector's hysteresis
-    /// (which a renderer keeps across frames) does not apply here.
-    fn build_auto(frame: &FrameContext<'_>, options: &TechniqueOptions) -> Result<Self, EvalError> {
-        let mut fitted: Vec<Option<Self>> = Vec::with_capacity(AUTO_CANDIDATES.len());
-        let mut predictions = Vec::with_capacity(AUTO_CANDIDATES.len());
-        for kind in AUTO_CANDIDATES {
-            let technique = Self::build(kind, frame, options).ok();
-            let prediction = technique.as_ref().and_then(|t| {
-                predict_error(
-                    frame.camera,
-                    &frame.scene.receivers,
-                    t,
-                    t.side,
-                    &PredictOptions::default(),
-                )
-                .ok()
-                .flatten()
-                .map(|p| p.percentile)
-            });
-            fitted.push(technique);
-            predictions.push(prediction);
-        }
-        let index = TechniqueSelector::new()
-            .choose(&predictions)
-            .ok_or_else(|| fail(TechniqueKind::Auto, &"no candidate could be fitted"))?;
-        let chosen = fitted[index]
-            .take()
-            .ok_or_else(|| fail(TechniqueKind::Auto, &"no candidate could be fitted"))?;
-        Ok(Self {
-            kind: TechniqueKind::Auto,
-            ..chosen
         })
     }
 
@@ -685,6 +654,44 @@ fn point_of(light: &Light) -> Option<(Vec3, f32)> {
     }
 }
 
+/// Ladder step of the stable cascades' sizes: a rung every half octave.
+const STABLE_SIZE_STEP: f32 = core::f32::consts::SQRT_2;
+
+/// Splits of the cascaded matrix techniques: practical splits of the eye's depth
+/// bounds (the camera's range without samples), so no cascade covers empty depth.
+/// The count follows the bounds' ratio `r = max / min`: with `k` maps sharing the
+/// budget, a logarithmic split leaves each cascade a depth ratio `r^(1/k)` on
+/// `side(k)` texels, so the count minimizing `r^(1/k) / side(k)` is taken, among the
+/// counts up to `options.cascades` whose side is a power of two when there are any
+/// (the stable fit's whole-texel motion is exact in `f32` only there).
+fn cascade_splits(
+    camera: &Camera,
+    samples: &[EyeSample],
+    options: &TechniqueOptions,
+) -> Result<CascadeSplits, shadowmap_frustum::FrustumError> {
+    let (near, far) = match depth_bounds(camera, samples) {
+        Some(bounds) => bounds.clamped_to(camera)?,
+        None => camera.depth_range()?,
+    };
+    let ratio = f64::from(far) / f64::from(near);
+    let max = options.cascades.clamp(1, shadowmap_frustum::MAX_CASCADES);
+    let power_of_two = |k: &usize| options.layer_side(*k as u32).is_power_of_two();
+    let any_power = (1..=max).any(|k| power_of_two(&k));
+    let cost = |k: usize| ratio.powf(1.0 / k as f64) / f64::from(options.layer_side(k as u32));
+    let count = (1..=max)
+        .filter(|k| !any_power || power_of_two(k))
+        .min_by(|a, b| cost(*a).total_cmp(&cost(*b)))
+        .unwrap_or(1);
+    CascadeSplits::new(
+        &SplitScheme::Practical {
+            lambda: options.split_lambda,
+        },
+        count,
+        near,
+        far,
+    )
+}
+
 /// Min/max view depth of the eye's samples (IPSM's truncated frustum), `None`
 /// without samples.
 fn depth_bounds(camera: &Camera, samples: &[EyeSample]) -> Option<DepthBounds> {
@@ -725,151 +732,5 @@ impl ShadowMapping for Technique {
             }
             .map_point(world),
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn budget_is_shared_evenly() {
-        let o = TechniqueOptions::default();
-        assert_eq!(o.layer_side(1), 1024);
-        assert_eq!(o.layer_side(4), 512);
-        assert_eq!(o.layer_side(2), 724);
-    }
-
-    #[test]
-    fn every_light_has_techniques() {
-        let d = Light::Directional {
-            direction: Vec3::NEG_Y,
-        };
-        let p = Light::Point {
-            position: Vec3::Y,
-            range: 10.0,
-        };
-        assert_eq!(TechniqueKind::for_light(&d).len(), 9);
-        assert_eq!(TechniqueKind::for_light(&p).len(), 3);
-        assert!(!TechniqueKind::SpotFit.applies_to(&d));
-    }
-
-    #[test]
-    fn auto_is_the_candidate_with_the_lowest_prediction() {
-        let camera = Camera::look_to(
-            Vec3::new(0.0, 10.0, 0.0),
-            Vec3::NEG_Z,
-            Vec3::Y,
-            shadowmap_frustum::Projection::perspective(1.0, 1.5, 1.0, 300.0),
-        )
-        .unwrap();
-        let light = Light::Directional {
-            direction: Vec3::new(0.3, -1.0, 0.1),
-        };
-        let b = shadowmap_frustum::Aabb::new(
-            Vec3::new(-300.0, 0.0, -320.0),
-            Vec3::new(300.0, 30.0, 20.0),
-        );
-        let frame = FrameContext {
-            camera: &camera,
-            light: &light,
-            scene: SceneBounds {
-                receivers: b,
-                casters: b,
-            },
-            eye_samples: &[],
-            pixels_per_radian: 100.0,
-        };
-        let o = TechniqueOptions::default().with_texel_budget(256 * 256);
-        let auto = Technique::build(TechniqueKind::Auto, &frame, &o).unwrap();
-        assert_eq!(auto.kind(), TechniqueKind::Auto);
-        assert!(AUTO_CANDIDATES.contains(&auto.chosen()));
-        let predicted = |t: &Technique| {
-            predict_error(&camera, &b, t, t.side, &PredictOptions::default())
-                .unwrap()
-                .unwrap()
-                .percentile
-        };
-        let chosen = Technique::build(auto.chosen(), &frame, &o).unwrap();
-        let best = AUTO_CANDIDATES
-            .iter()
-            .filter_map(|k| Technique::build(*k, &frame, &o).ok())
-            .map(|t| predicted(&t))
-            .fold(f64::INFINITY, f64::min);
-        assert_eq!(predicted(&auto), predicted(&chosen));
-        assert_eq!(predicted(&chosen), best);
-        // A perspective view over open ground: a warp beats the uniform fit.
-        assert_ne!(auto.chosen(), TechniqueKind::UniformFocused);
-        let p = DVec3::new(1.0, 0.0, -20.0);
-        assert_eq!(auto.map_point(p), chosen.map_point(p));
-    }
-
-    #[test]
-    fn wrong_light_or_bad_frame_is_a_typed_error() {
-        let camera = Camera::look_to(
-            Vec3::new(0.0, 2.0, 0.0),
-            Vec3::NEG_Z,
-            Vec3::Y,
-            shadowmap_frustum::Projection::perspective(1.0, 1.5, 0.5, 100.0),
-        )
-        .unwrap();
-        let light = Light::Directional {
-            direction: Vec3::NEG_Y,
-        };
-        let b = shadowmap_frustum::Aabb::new(Vec3::splat(-50.0), Vec3::splat(50.0));
-        let frame = FrameContext {
-            camera: &camera,
-            light: &light,
-            scene: SceneBounds {
-                receivers: b,
-                casters: b,
-            },
-            eye_samples: &[],
-            pixels_per_radian: 100.0,
-        };
-        let o = TechniqueOptions::default().with_texel_budget(64 * 64);
-        let err = Technique::build(TechniqueKind::IpsmExact, &frame, &o).unwrap_err();
-        assert!(matches!(
-            err,
-            EvalError::Technique {
-                technique: "ipsm_exact",
-                ..
-            }
-        ));
-        // Receivers behind the camera: the warp crate's error, not a panic.
-        let behind =
-            shadowmap_frustum::Aabb::new(Vec3::new(-5.0, -5.0, 10.0), Vec3::new(5.0, 5.0, 20.0));
-        let frame = FrameContext {
-            scene: SceneBounds {
-                receivers: behind,
-                casters: behind,
-            },
-            ..frame
-        };
-        // (Stable cascades have a documented fallback instead: the whole slice.)
-        for kind in TechniqueKind::for_light(&light) {
-            if kind == TechniqueKind::StableCascades {
-                assert!(Technique::build(kind, &frame, &o).is_ok());
-                continue;
-            }
-            match Technique::build(kind, &frame, &o) {
-                Err(EvalError::Technique { reason, .. }) => assert!(!reason.is_empty()),
-                other => panic!("{}: {other:?}", kind.name()),
-            }
-        }
-        // A valid frame builds every directional technique within the budget.
-        let t = Technique::build(
-            TechniqueKind::StableCascades,
-            &FrameContext {
-                scene: SceneBounds {
-                    receivers: b,
-                    casters: b,
-                },
-                ..frame
-            },
-            &o,
-        )
-        .unwrap();
-        assert_eq!((t.layers(), t.texels()), (4, 4 * 32 * 32));
     }
 }

@@ -110,6 +110,27 @@ impl Camera {
         Ok(camera)
     }
 
+    /// As [`Camera::look_to`] for a reversed-Z camera: validated with the depth
+    /// convention it will be used with (a custom reversed-Z matrix is read with its
+    /// near plane at depth 1), which `look_to(..)?.with_reversed_z(true)` cannot do.
+    ///
+    /// # Errors
+    /// As [`Camera::look_to`].
+    pub fn look_to_reversed_z(
+        eye: Vec3,
+        forward: Vec3,
+        up: Vec3,
+        projection: Projection,
+    ) -> Result<Self, FrustumError> {
+        let camera = Self {
+            world_from_view: world_from_view_look_to(eye, forward, up)?,
+            projection,
+            reversed_z: true,
+        };
+        camera.validate()?;
+        Ok(camera)
+    }
+
     /// A camera at `eye` looking at `target`.
     ///
     /// # Errors
@@ -140,7 +161,11 @@ impl Camera {
     /// a range too thin for `f32`), [`FrustumError::InvalidProjection`] for a custom
     /// matrix that is singular or does not look down `-Z`,
     /// [`FrustumError::DegenerateFrustum`] for a frustum with no volume at `f32`
-    /// precision or with a corner farther than 1e15 from the origin.
+    /// precision, with a corner farther than 1e15 from the origin, or whose `f32`
+    /// `clip_from_world` cannot keep its near and far planes apart. A wide depth range
+    /// is not degenerate: far / near of 1e6 and beyond validates with either depth
+    /// convention. Validation uses the camera's own `reversed_z` (see
+    /// [`Camera::look_to_reversed_z`]).
     pub fn validate(&self) -> Result<(), FrustumError> {
         self.clip_from_world().map(|_| ())
     }
@@ -151,7 +176,7 @@ impl Camera {
     /// # Errors
     /// As [`Camera::validate`].
     pub fn view_from_world(&self) -> Result<Mat4, FrustumError> {
-        Ok(self.geometry()?.world_from_view.inverse().as_mat4())
+        Ok(self.geometry()?.view_from_world().as_mat4())
     }
 
     /// Camera position in world space.
@@ -188,8 +213,13 @@ impl Camera {
     /// As [`Camera::validate`].
     pub fn clip_from_view(&self) -> Result<Mat4, FrustumError> {
         self.geometry()?;
+        Ok(self.projection_matrix())
+    }
+
+    /// The projection matrix of a camera whose geometry has been validated.
+    fn projection_matrix(&self) -> Mat4 {
         let rev = self.reversed_z;
-        let m = match self.projection {
+        match self.projection {
             Projection::Perspective {
                 fov_y,
                 aspect,
@@ -233,8 +263,7 @@ impl Camera {
             )
             .as_mat4(),
             Projection::Custom { clip_from_view, .. } => clip_from_view,
-        };
-        Ok(m)
+        }
     }
 
     /// `clip_from_view * view_from_world`.
@@ -242,18 +271,10 @@ impl Camera {
     /// # Errors
     /// As [`Camera::validate`].
     pub fn clip_from_world(&self) -> Result<Mat4, FrustumError> {
-        let view_from_world = self.geometry()?.world_from_view.inverse();
-        let clip_from_view = self.clip_from_view()?.as_dmat4();
-        let m = (clip_from_view * view_from_world).as_mat4();
-        // Far from the origin with a tiny near plane, f32 cannot tell the depth row
-        // from the w row.
         let g = self.geometry()?;
-        let reach = g
-            .world_corners(g.near, g.far)
-            .iter()
-            .map(|c| c.abs().max_element())
-            .fold(0.0, f64::max);
-        if crate::is_invertible(&m, reach as f32) {
+        let exact = self.projection_matrix().as_dmat4() * g.view_from_world();
+        let m = exact.as_mat4();
+        if resolves_depth_range(&m, &exact, &g.world_corners(g.near, g.far)) {
             Ok(m)
         } else {
             Err(FrustumError::DegenerateFrustum)
@@ -285,6 +306,40 @@ impl Camera {
     pub(crate) fn geometry(&self) -> Result<CameraGeometry, FrustumError> {
         CameraGeometry::new(self)
     }
+}
+
+/// Whether the `f32` camera matrix `m` (rounded from `exact`) resolves the depth
+/// range: it is finite and invertible, and evaluated in `f32` it puts every corner in
+/// front of the eye and within a quarter of the near-to-far depth separation of the
+/// depth `exact` gives it, so near and far stay apart and in order. Far from the
+/// origin with a tiny near plane the depth row rounds onto the `w` row and the near
+/// corners land anywhere; a wide depth range alone does not fail (standard depth
+/// only loses precision near the far plane, reversed-Z hardly any).
+fn resolves_depth_range(m: &Mat4, exact: &DMat4, corners: &[DVec3; 8]) -> bool {
+    if !m.is_finite() {
+        return false;
+    }
+    let det = m.as_dmat4().determinant();
+    if !(det != 0.0 && det.is_finite()) {
+        return false;
+    }
+    let depth64 = |c: DVec3| {
+        let h = *exact * c.extend(1.0);
+        h.z / h.w
+    };
+    let depth32 = |c: DVec3| {
+        let h = *m * c.as_vec3().extend(1.0);
+        (h.w > 0.0).then_some(f64::from(h.z / h.w))
+    };
+    (0..4).all(|i| {
+        let (near, far) = (corners[i], corners[i + 4]);
+        let (e_near, e_far) = (depth64(near), depth64(far));
+        let separation = (e_far - e_near).abs();
+        let close = |c: DVec3, e: f64| {
+            depth32(c).is_some_and(|d| d.is_finite() && (d - e).abs() <= 0.25 * separation)
+        };
+        separation > 0.0 && separation.is_finite() && close(near, e_near) && close(far, e_far)
+    })
 }
 
 fn world_from_view_look_to(eye: Vec3, forward: Vec3, up: Vec3) -> Result<Mat4, FrustumError> {
@@ -485,8 +540,9 @@ impl CameraGeometry {
         }
         let rounded = corners.map(|c| c.as_vec3().as_dvec3());
         dplanes(&rounded, f32_min_distance(&rounded))?;
-        // ...and every builder's own construction of it must succeed too.
-        Frustum::from_dcorners(&corners)?;
+        // ...and every builder's own construction of it must succeed too (the `f32`
+        // corners are finite, checked above).
+        dplanes(&corners, 0.0)?;
         Ok(geometry)
     }
 
@@ -562,6 +618,24 @@ impl CameraGeometry {
             }
         }
         Ok((near, far, origin, dir))
+    }
+
+    /// The inverse of the (orthonormal) pose: the transposed rotation and the
+    /// rotated, negated eye, exact where a general inverse would round.
+    pub(crate) fn view_from_world(&self) -> DMat4 {
+        let m = &self.world_from_view;
+        let (x, y, z) = (
+            m.x_axis.truncate(),
+            m.y_axis.truncate(),
+            m.z_axis.truncate(),
+        );
+        let eye = m.w_axis.truncate();
+        DMat4::from_cols(
+            DVec4::new(x.x, y.x, z.x, 0.0),
+            DVec4::new(x.y, y.y, z.y, 0.0),
+            DVec4::new(x.z, y.z, z.z, 0.0),
+            DVec4::new(-x.dot(eye), -y.dot(eye), -z.dot(eye), 1.0),
+        )
     }
 
     /// Clamps and checks a requested slice against the camera's range.
@@ -691,7 +765,7 @@ pub(crate) fn dplanes(
     let centroid = corners.iter().fold(DVec3::ZERO, |s, c| s + *c) / 8.0;
     let scale = corners
         .iter()
-        .map(|c| (*c - centroid).length())
+        .map(|c| (*c - centroid).length_squared())
         .fold(0.0, f64::max);
     if !(scale > 0.0 && scale.is_finite()) {
         return Err(FrustumError::DegenerateFrustum);

@@ -84,13 +84,14 @@ pub fn fit_spot(
         d_min = d_min.min(d);
         d_max = d_max.max(d);
     }
+    // Nothing in front of the light: the region lies wholly behind it.
+    if !d_min.is_finite() {
+        return Err(FrustumError::SliceOutsideScene);
+    }
     if straddles {
         tangents = [-cone_tan, cone_tan, -cone_tan, cone_tan];
         d_min = near_min;
         d_max = d_max.max(range);
-    }
-    if !d_min.is_finite() {
-        return Err(FrustumError::SliceOutsideScene);
     }
     let [l, r, b, t] = [
         tangents[0].max(-cone_tan),

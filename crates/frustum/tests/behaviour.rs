@@ -560,3 +560,133 @@ fn extruded_body_reaches_the_scene_boundary_toward_the_light() {
             .is_empty()
     );
 }
+
+/// A wide depth range (far / near = 1e6) has volume and resolves in `f32` with either
+/// depth convention: both validate, and the matrices keep near and far apart.
+#[test]
+fn wide_depth_range_validates_with_both_depth_conventions() {
+    let p = Projection::perspective(1.0, 16.0 / 9.0, 0.1, 1e5);
+    let eye = Vec3::new(3.0, 2.0, -1.0);
+    let standard = Camera::look_to(eye, Vec3::new(0.2, -0.1, -1.0), Vec3::Y, p).unwrap();
+    let reversed = Camera::look_to_reversed_z(eye, Vec3::new(0.2, -0.1, -1.0), Vec3::Y, p).unwrap();
+    assert!(reversed.reversed_z && !standard.reversed_z);
+    assert_eq!(standard.with_reversed_z(true), reversed);
+    for (camera, near_depth) in [(standard, 0.0), (reversed, 1.0)] {
+        let clip = camera.clip_from_world().unwrap();
+        let project = |d: f32| {
+            let h = clip * (eye + camera.forward() * d).extend(1.0);
+            h.z / h.w
+        };
+        assert!((project(0.1) - near_depth).abs() < 1e-3);
+        assert!((project(1e5) - (1.0 - near_depth)).abs() < 1e-3);
+        assert_ne!(project(1e3), project(1e5));
+    }
+    // Still refused: a frustum f32 cannot place (tiny near plane far from the origin).
+    let tiny = Projection::perspective(1.0, 1.0, 1e-3, 1e5);
+    assert_eq!(
+        Camera::look_to(Vec3::splat(1e6), Vec3::NEG_Z, Vec3::Y, tiny).map(|_| ()),
+        Err(FrustumError::DegenerateFrustum)
+    );
+}
+
+/// A custom reversed-Z projection validates through `look_to_reversed_z`, which reads
+/// its near plane at depth 1; `look_to` reads it as standard depth and refuses it.
+#[test]
+fn custom_reversed_z_matrix_validates_with_its_convention() {
+    let clip_from_view = projection::perspective(1.0, 1.5, 0.5, 300.0, true).as_mat4();
+    let p = Projection::Custom {
+        clip_from_view,
+        shadow_distance: 200.0,
+    };
+    let camera = Camera::look_to_reversed_z(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y, p).unwrap();
+    let (near, far) = camera.depth_range().unwrap();
+    assert_relative_eq!(near, 0.5, max_relative = 1e-4);
+    assert_relative_eq!(far, 200.0, max_relative = 1e-4);
+    assert!(Camera::look_to(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y, p).is_err());
+}
+
+/// A region wholly behind the spot light is outside what it can light.
+#[test]
+fn spot_with_region_behind_it_is_outside_the_scene() {
+    let frustum = camera().frustum().unwrap();
+    // The camera looks down -Z from the origin area; the spot sits far in front of
+    // it and points back the other way (+Z), away from everything the camera sees.
+    let light = Light::Spot {
+        position: Vec3::new(0.0, 2.0, -2000.0),
+        direction: Vec3::new(0.0, 0.0, -1.0),
+        half_angle: 0.7,
+        range: 100.0,
+    };
+    assert_eq!(
+        fit_spot(&light, &frustum, None, false),
+        Err(FrustumError::SliceOutsideScene)
+    );
+    let ground = Aabb::new(Vec3::new(-40.0, -0.1, -60.0), Vec3::new(40.0, 0.0, 0.0));
+    let scene = SceneBounds {
+        receivers: ground,
+        casters: ground,
+    };
+    let behind = Light::Spot {
+        position: Vec3::new(0.0, 5.0, -100.0),
+        direction: Vec3::new(0.0, 0.0, -1.0),
+        half_angle: 0.7,
+        range: 100.0,
+    };
+    assert_eq!(
+        fit_spot(&behind, &frustum, Some(&scene), false),
+        Err(FrustumError::SliceOutsideScene)
+    );
+}
+
+/// The stable fit on a size ladder: fitted to slice ∩ receivers, so much smaller than
+/// the whole slice's sphere over a small receiver; the size stays on its rung while
+/// the camera moves a little, and the map moves by whole texels.
+#[test]
+fn stable_size_ladder_fits_receivers_and_keeps_its_size() {
+    let cam = camera();
+    let splits = CascadeSplits::new(&SplitScheme::Logarithmic, 2, 1.0, 1000.0).unwrap();
+    let ground = Aabb::new(Vec3::new(-5.0, -0.1, -60.0), Vec3::new(5.0, 0.0, -40.0));
+    let scene = SceneBounds {
+        receivers: ground,
+        casters: ground,
+    };
+    let light = Vec3::new(-0.3, -1.0, -0.2);
+    let whole = CascadeOptions::default()
+        .with_resolution(1024)
+        .with_scene(Some(scene));
+    let ladder = whole.with_stable_size_step(Some(std::f32::consts::SQRT_2));
+    let a = CascadeSet::fit(&cam, light, &splits, &whole).unwrap();
+    let b = CascadeSet::fit(&cam, light, &splits, &ladder).unwrap();
+    let (ta, tb) = (
+        a.cascades[1].texel_world_size,
+        b.cascades[1].texel_world_size,
+    );
+    assert!(tb < 0.2 * ta, "{tb} vs {ta}");
+    // Needed side at most 60 units (the receiver's diagonal): at most sqrt 2 more.
+    assert!(
+        tb * 1022.0 <= 60.0 * std::f32::consts::SQRT_2 * 1.001,
+        "{tb}"
+    );
+    let moved = Camera {
+        world_from_view: Mat4::from_translation(Vec3::new(0.01, 0.0, 0.0)) * cam.world_from_view,
+        ..cam
+    };
+    let c = CascadeSet::fit(&moved, light, &splits, &ladder).unwrap();
+    assert_eq!(c.cascades[1].texel_world_size, tb);
+    let p = Vec3::new(1.0, 0.0, -50.0);
+    let (sb, sc) = (
+        b.cascades[1].transform.project(p).unwrap(),
+        c.cascades[1].transform.project(p).unwrap(),
+    );
+    let texels = (sc.uv - sb.uv) * 1024.0;
+    assert!((texels - texels.round()).length() < 1e-3, "{texels}");
+    assert_eq!(
+        CascadeSet::fit(
+            &cam,
+            light,
+            &splits,
+            &whole.with_stable_size_step(Some(1.0))
+        ),
+        Err(FrustumError::InvalidSplitParameter)
+    );
+}

@@ -11,6 +11,11 @@ use shadowmap_frustum::{
     Frustum, Light, SceneBounds, SplitScheme, directional_light_from_world, fit_spot,
 };
 
+/// The crate these generators build values of. `shadowmap-frustum`'s own unit tests
+/// compile a second copy of it, so they name the generators' types through this path
+/// to convert them.
+pub use shadowmap_frustum as built;
+
 use crate::{
     GenResult, aabb, aabb_raw, any_f32, any_vec3, camera, camera_raw, depth_range_raw, in_range,
     light_direction, log_uniform, split_scheme_raw, unit_vec3,
@@ -198,7 +203,12 @@ pub fn cascade_case_raw(u: &mut Unstructured<'_>) -> GenResult<CascadeCase> {
         } else {
             any_vec3(u)?
         })
-        .with_scene(scene);
+        .with_scene(scene)
+        .with_stable_size_step(match u.int_in_range(0u8..=2)? {
+            0 => None,
+            1 => Some(in_range(u, 1.0001, 4.0)?),
+            _ => Some(any_f32(u)?),
+        });
     Ok(CascadeCase {
         camera,
         light,

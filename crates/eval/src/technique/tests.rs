@@ -1,0 +1,146 @@
+//! Unit tests of the technique list, the budget and `auto`.
+use shadowmap_frustum::{PredictOptions, predict_error};
+
+use super::*;
+
+#[test]
+fn budget_is_shared_evenly() {
+    let o = TechniqueOptions::default();
+    assert_eq!(o.layer_side(1), 1024);
+    assert_eq!(o.layer_side(4), 512);
+    assert_eq!(o.layer_side(2), 724);
+}
+
+#[test]
+fn every_light_has_techniques() {
+    let d = Light::Directional {
+        direction: Vec3::NEG_Y,
+    };
+    let p = Light::Point {
+        position: Vec3::Y,
+        range: 10.0,
+    };
+    assert_eq!(TechniqueKind::for_light(&d).len(), 10);
+    assert_eq!(TechniqueKind::for_light(&p).len(), 3);
+    assert!(!TechniqueKind::SpotFit.applies_to(&d));
+}
+
+#[test]
+fn auto_is_the_candidate_with_the_lowest_prediction() {
+    let camera = Camera::look_to(
+        Vec3::new(0.0, 10.0, 0.0),
+        Vec3::NEG_Z,
+        Vec3::Y,
+        shadowmap_frustum::Projection::perspective(1.0, 1.5, 1.0, 300.0),
+    )
+    .unwrap();
+    let light = Light::Directional {
+        direction: Vec3::new(0.3, -1.0, 0.1),
+    };
+    let b =
+        shadowmap_frustum::Aabb::new(Vec3::new(-300.0, 0.0, -320.0), Vec3::new(300.0, 30.0, 20.0));
+    let frame = FrameContext {
+        camera: &camera,
+        light: &light,
+        scene: SceneBounds {
+            receivers: b,
+            casters: b,
+        },
+        eye_samples: &[],
+        pixels_per_radian: 100.0,
+    };
+    let o = TechniqueOptions::default().with_texel_budget(256 * 256);
+    let auto = Technique::build(TechniqueKind::Auto, &frame, &o).unwrap();
+    assert_eq!(auto.kind(), TechniqueKind::Auto);
+    assert!(AUTO_CANDIDATES.contains(&auto.chosen()));
+    let predicted = |t: &Technique| {
+        predict_error(&camera, &b, t, t.side, &PredictOptions::default())
+            .unwrap()
+            .unwrap()
+            .percentile
+    };
+    let chosen = Technique::build(auto.chosen(), &frame, &o).unwrap();
+    let best = AUTO_CANDIDATES
+        .iter()
+        .filter_map(|k| Technique::build(*k, &frame, &o).ok())
+        .map(|t| predicted(&t))
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(predicted(&auto), predicted(&chosen));
+    assert_eq!(predicted(&chosen), best);
+    // A perspective view over open ground: a warp beats the uniform fit.
+    assert_ne!(auto.chosen(), TechniqueKind::UniformFocused);
+    let p = DVec3::new(1.0, 0.0, -20.0);
+    assert_eq!(auto.map_point(p), chosen.map_point(p));
+}
+
+#[test]
+fn wrong_light_or_bad_frame_is_a_typed_error() {
+    let camera = Camera::look_to(
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::NEG_Z,
+        Vec3::Y,
+        shadowmap_frustum::Projection::perspective(1.0, 1.5, 0.5, 100.0),
+    )
+    .unwrap();
+    let light = Light::Directional {
+        direction: Vec3::NEG_Y,
+    };
+    let b = shadowmap_frustum::Aabb::new(Vec3::splat(-50.0), Vec3::splat(50.0));
+    let frame = FrameContext {
+        camera: &camera,
+        light: &light,
+        scene: SceneBounds {
+            receivers: b,
+            casters: b,
+        },
+        eye_samples: &[],
+        pixels_per_radian: 100.0,
+    };
+    let o = TechniqueOptions::default().with_texel_budget(64 * 64);
+    let err = Technique::build(TechniqueKind::IpsmExact, &frame, &o).unwrap_err();
+    assert!(matches!(
+        err,
+        EvalError::Technique {
+            technique: "ipsm_exact",
+            ..
+        }
+    ));
+    // Receivers behind the camera: the warp crate's error, not a panic.
+    let behind =
+        shadowmap_frustum::Aabb::new(Vec3::new(-5.0, -5.0, 10.0), Vec3::new(5.0, 5.0, 20.0));
+    let frame = FrameContext {
+        scene: SceneBounds {
+            receivers: behind,
+            casters: behind,
+        },
+        ..frame
+    };
+    // (Stable cascades have a documented fallback instead: the whole slice.)
+    for kind in TechniqueKind::for_light(&light) {
+        if matches!(
+            kind,
+            TechniqueKind::StableCascades | TechniqueKind::TightCascades
+        ) {
+            assert!(Technique::build(kind, &frame, &o).is_ok());
+            continue;
+        }
+        match Technique::build(kind, &frame, &o) {
+            Err(EvalError::Technique { reason, .. }) => assert!(!reason.is_empty()),
+            other => panic!("{}: {other:?}", kind.name()),
+        }
+    }
+    // A valid frame builds every directional technique within the budget.
+    let t = Technique::build(
+        TechniqueKind::StableCascades,
+        &FrameContext {
+            scene: SceneBounds {
+                receivers: b,
+                casters: b,
+            },
+            ..frame
+        },
+        &o,
+    )
+    .unwrap();
+    assert_eq!((t.layers(), t.texels()), (4, 4 * 32 * 32));
+}
