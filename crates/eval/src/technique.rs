@@ -367,20 +367,13 @@ impl Technique {
                 (Inner::Cascades(Box::new(set)), layers, side)
             }
             TechniqueKind::WarpedCascades => {
-                let count = options.cascades;
+                // The same split rule as the unwarped cascades: count and range from
+                // the eye's depth bounds, so no cascade is spent on empty depth.
+                let splits =
+                    cascade_splits(camera, frame.eye_samples, options).map_err(|x| e(&x))?;
+                let count = splits.count();
                 let layers = u32::try_from(count).unwrap_or(u32::MAX);
                 let side = options.layer_side(layers);
-                let (near, far) = camera.depth_range().map_err(|x| e(&x))?;
-                let splits = CascadeSplits::new(
-                    &SplitScheme::Practical {
-                        lambda: options.split_lambda,
-                    },
-                    count,
-                    near,
-                    far,
-                )
-                .and_then(|s| s.with_overlap(0.0))
-                .map_err(|x| e(&x))?;
                 let etas = vec![0.0; count];
                 let w = warped_cascades(
                     camera,

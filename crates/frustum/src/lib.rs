@@ -17,7 +17,7 @@
 //! - a perspective fit for spot lights ([`fit_spot`]).
 //!
 //! The algorithms follow Zhang et al., *Parallel-Split Shadow Maps* (2006) and the PSSM
-//! thesis in `shared/seeds`.
+//! thesis of Ferko (*Shadow Mapping for Large Virtual Environments*, Comenius University, 2010).
 //!
 //! # Example
 //!

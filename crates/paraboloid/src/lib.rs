@@ -5,7 +5,7 @@
 //! map (Brabec, Annen and Seidel, *Shadow mapping for hemispherical and omnidirectional
 //! light sources*, CGI 2002) stores a hemisphere in one texture; two of them back to
 //! back (DPSM) store the whole sphere. IPSM (Vanek, Navrátil, Herout and Zemčík,
-//! *High-Quality Shadows with Improved Paraboloid Mapping*, ISVC 2011; `shared/seeds`)
+//! *High-Quality Shadows with Improved Paraboloid Mapping*, ISVC 2011)
 //! turns the front paraboloid toward the visible part of the scene and cuts it to the
 //! light cone that covers the truncated view frustum, so one map, with more texels
 //! where they matter, often does the job.

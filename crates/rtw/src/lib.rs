@@ -2,7 +2,7 @@
 //! forward and inverse warp that reproduce the shader's texture sampling exactly.
 //!
 //! RTW (Paul Rosen, *Rectilinear Texture Warping for Fast Adaptive Shadow Mapping*,
-//! I3D 2012; see also the Grøn & Sørensen report in `shared/seeds`) renders one
+//! I3D 2012; see also Grøn and Sørensen's report on rectilinear texture warping) renders one
 //! ordinary shadow map whose texels are redistributed along `u` and `v` by two 1-D
 //! warps, so that regions that matter to the eye get more texels:
 //!

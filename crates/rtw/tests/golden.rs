@@ -1,4 +1,4 @@
-//! Overhead-light golden case (GUIDE §5): camera looking horizontally, light straight
+//! Overhead-light golden case (`docs/quality.md`): camera looking horizontally, light straight
 //! down, n = 1, f = 1000, fovY = 60°. Fed the oracle importance with no blur, the RTW
 //! warp's texel density along the view direction follows the ideal `1/z` profile.
 

@@ -383,7 +383,7 @@ mod tests {
     /// density ratios are the closed forms of the 1-D analysis (Wimmer et al. 2004,
     /// Lloyd et al. 2006): `r = 1 + s d` is 1 (uniform), `sqrt(f/n)` (LiSPSM) and
     /// `f/n` (PSM); along the view the ratio is `r²`, across it `r`. The storage
-    /// factors are GUIDE §5's: uniform `K (f - n) f / n²`, LiSPSM `K (f - n) / n`
+    /// factors are those of `docs/quality.md`: uniform `K (f - n) f / n²`, LiSPSM `K (f - n) / n`
     /// (and PSM the same as LiSPSM in this separable 1-D measure).
     #[test]
     fn overhead_light_golden_ratios() {
@@ -433,7 +433,7 @@ mod tests {
                 "eta {eta}: across {across} vs {want_across}"
             );
         }
-        // The storage factors of GUIDE §5 from the measured densities (perspective-only,
+        // The storage factors of `docs/quality.md` from the measured densities (perspective-only,
         // separable): S = max_z m_x(z) * max_z m_y(z) * (texels across the map) with
         // m = (pixel density 1/(2 t z)) / (texel density), t = tan(fovY / 2).
         let tan = (30f64).to_radians().tan();
