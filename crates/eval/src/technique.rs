@@ -58,7 +58,7 @@ pub enum TechniqueKind {
     UniformFocused,
     /// PSSM, stable: `CascadeSet::fit` with the stable fit clipped to the receivers on a
     /// ladder of sizes; practical splits of the eye's depth bounds, cascade count from
-    /// their ratio (see [`cascade_splits`]).
+    /// their ratio (see `cascade_splits`).
     StableCascades,
     /// PSSM, tight (SDSM-style): `CascadeSet::fit` with the tight fit to slice ∩
     /// receivers over the same splits as [`TechniqueKind::StableCascades`].

@@ -46,7 +46,7 @@ impl ConvexBody {
         corners: &[DVec3; 8],
         aabb: &Aabb,
     ) -> Result<Self, FrustumError> {
-        let planes = crate::camera::dplanes(corners, 0.0)?;
+        let planes = crate::frustum::dplanes(corners, 0.0)?;
         Self::from_planes_aabb(&planes, &corners.map(DVec3::as_vec3), aabb)
     }
 

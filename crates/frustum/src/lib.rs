@@ -79,6 +79,7 @@ mod camera;
 mod cascade;
 mod depth_bounds;
 mod error;
+mod frustum;
 mod geometry;
 mod light;
 mod mapping;
@@ -89,12 +90,13 @@ mod split;
 mod spot;
 
 pub use body::{ConvexBody, MAX_BODY_VERTICES};
-pub use camera::{Camera, Frustum, Projection};
+pub use camera::{Camera, Projection};
 pub use cascade::{
     Cascade, CascadeFit, CascadeOptions, CascadeSet, MAX_RESOLUTION, SceneBounds, fit_cascade,
 };
 pub use depth_bounds::DepthBounds;
 pub use error::FrustumError;
+pub use frustum::Frustum;
 pub use geometry::{Aabb, Plane, Sphere};
 pub use light::{Light, directional_light_from_world};
 pub use mapping::{

@@ -1,0 +1,168 @@
+use super::*;
+use glam::Mat4;
+
+fn identity_base() -> ShadowTransform {
+    // uv = (x, y) directly: clip x = 2u - 1, clip y = 1 - 2v.
+    let clip = Mat4::from_cols_array(&[
+        2.0, 0.0, 0.0, 0.0, //
+        0.0, -2.0, 0.0, 0.0, //
+        0.0, 0.0, 1.0, 0.0, //
+        -1.0, 1.0, 0.0, 1.0,
+    ]);
+    ShadowTransform::new(
+        Mat4::IDENTITY,
+        clip,
+        false,
+        LightDirection::Directional(Vec3::NEG_Z),
+    )
+}
+
+#[test]
+fn sizes_and_values_are_checked() {
+    assert_eq!(ImportanceMap::new(0, 4), Err(RtwError::EmptyMap));
+    assert_eq!(
+        ImportanceMap::new(MAX_MAP_SIDE + 1, 1),
+        Err(RtwError::MapTooLarge)
+    );
+    let mut m = ImportanceMap::new(4, 2).unwrap();
+    assert_eq!(m.set(4, 0, 1.0), Err(RtwError::OutOfBounds));
+    assert_eq!(m.set(0, 0, f32::NAN), Err(RtwError::NonFinite));
+    assert_eq!(m.set(0, 0, -1.0), Err(RtwError::NegativeImportance));
+    assert_eq!(
+        m.copy_from_slice(&[1.0; 3]),
+        Err(RtwError::SizeMismatch {
+            expected: 8,
+            got: 3
+        })
+    );
+    m.set(3, 1, 2.0).unwrap();
+    assert_eq!(m.get(3, 1), Some(2.0));
+    assert_eq!(m.as_slice()[7], 2.0);
+}
+
+#[test]
+fn backward_analysis_prefers_near_samples_and_edges() {
+    let mut m = ImportanceMap::new(4, 4).unwrap();
+    let base = identity_base();
+    let near = EyeSample {
+        position: Vec3::new(0.1, 0.1, 0.0),
+        normal: Vec3::Z,
+        eye_distance: 1.0,
+    };
+    let far = EyeSample {
+        position: Vec3::new(0.9, 0.9, 0.0),
+        eye_distance: 10.0,
+        ..near
+    };
+    let outside = EyeSample {
+        position: Vec3::new(2.0, 0.5, 0.0),
+        ..near
+    };
+    let opts = ImportanceOptions::default();
+    let st = m
+        .accumulate_backward(&base, &[near, far, outside], None, &opts)
+        .unwrap();
+    assert_eq!(
+        st,
+        AccumulateStats {
+            accepted: 2,
+            skipped: 1
+        }
+    );
+    assert!((m.get(0, 0).unwrap() - 1.0).abs() < 1e-6);
+    assert!((m.get(3, 3).unwrap() - 0.1).abs() < 1e-6);
+    // Edge factor.
+    m.accumulate_backward(&base, &[far], Some(&[true]), &opts)
+        .unwrap();
+    assert!((m.get(3, 3).unwrap() - 0.4).abs() < 1e-6);
+    // Grazing light raises importance.
+    let graze = EyeSample {
+        normal: Vec3::X,
+        ..far
+    };
+    m.clear();
+    m.accumulate_backward(&base, &[graze], None, &opts).unwrap();
+    assert!((m.get(3, 3).unwrap() - 0.2).abs() < 1e-6);
+    // Errors leave the map unchanged.
+    let bad = EyeSample {
+        eye_distance: f32::NAN,
+        ..near
+    };
+    assert_eq!(
+        m.accumulate_backward(&base, &[near, bad], None, &opts),
+        Err(RtwError::NonFinite)
+    );
+    assert_eq!(m.get(0, 0), Some(0.0));
+    assert!(matches!(
+        m.accumulate_backward(&base, &[near], Some(&[]), &opts),
+        Err(RtwError::SizeMismatch { .. })
+    ));
+}
+
+#[test]
+fn forward_analysis_lifts_texels_the_eye_sees() {
+    use shadowmap_frustum::{CascadeFit, CascadeOptions, Projection, fit_cascade};
+    let camera = Camera::look_to(
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::NEG_Z,
+        Vec3::Y,
+        Projection::perspective(1.0, 1.0, 0.1, 50.0),
+    )
+    .unwrap();
+    let opts = CascadeOptions::default().with_fit(CascadeFit::Tight);
+    let base = fit_cascade(&camera, Vec3::NEG_Y, 0.1, 50.0, &opts)
+        .unwrap()
+        .transform;
+    // A previous map of the ground plane y = 0 where the eye sees it; empty elsewhere.
+    let (dw, dh) = (32u32, 32u32);
+    let mut depths = vec![1.0f32; (dw * dh) as usize];
+    let seen = [Vec3::new(0.0, 0.0, -3.0), Vec3::new(0.5, 0.0, -30.0)];
+    let mut texels = Vec::new();
+    for p in seen {
+        let s = base.project(p).unwrap();
+        let (i, j) = (
+            (s.uv.x * f64::from(dw)) as usize,
+            (s.uv.y * f64::from(dh)) as usize,
+        );
+        depths[j * dw as usize + i] = s.depth as f32;
+        texels.push((i, j));
+    }
+    // A texel inside the base map that the eye does not see.
+    let hidden = Vec3::new(-20.0, 0.0, -5.0);
+    let behind = base.project(hidden).unwrap();
+    assert!(behind.uv.cmpge(glam::DVec2::ZERO).all() && behind.uv.cmplt(glam::DVec2::ONE).all());
+    let (bi, bj) = ((behind.uv.x * 32.0) as usize, (behind.uv.y * 32.0) as usize);
+    depths[bj * 32 + bi] = behind.depth as f32;
+
+    let mut m = ImportanceMap::new(16, 16).unwrap();
+    let options = ImportanceOptions::default();
+    let st = m
+        .accumulate_forward(&base, &base, None, &depths, dw, dh, &camera, &options)
+        .unwrap();
+    assert_eq!(st.accepted, 2, "{st:?}");
+    assert_eq!(st.skipped, depths.len() - 2);
+    let cell = |p: Vec3| {
+        let s = base.project(p).unwrap();
+        m.get((s.uv.x * 16.0) as u32, (s.uv.y * 16.0) as u32)
+            .unwrap()
+    };
+    // Importance = 1 / view depth, up to the texel's extent.
+    assert!((cell(seen[0]) - 1.0 / 3.0).abs() < 0.1, "{}", cell(seen[0]));
+    assert!(
+        (cell(seen[1]) - 1.0 / 30.0).abs() < 0.01,
+        "{}",
+        cell(seen[1])
+    );
+    assert_eq!(cell(hidden), 0.0);
+    assert!(matches!(
+        m.accumulate_forward(&base, &base, None, &depths[1..], dw, dh, &camera, &options),
+        Err(RtwError::SizeMismatch { .. })
+    ));
+}
+
+#[test]
+fn singular_min_is_right() {
+    let s = singular_min(3.0, 0.0, 0.0, 2.0).unwrap();
+    assert!((s - 2.0).abs() < 1e-12);
+    assert!(singular_min(1.0, 1.0, 1.0, 1.0).is_none());
+}
