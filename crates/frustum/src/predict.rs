@@ -22,7 +22,7 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
-use crate::{Aabb, Camera, FrustumError, ShadowMapping};
+use crate::{Aabb, Camera, FrustumError, ShadowMapping, math};
 
 /// Most rays [`predict_error`] casts (`grid_columns * grid_rows` at most this).
 pub const MAX_PREDICT_RAYS: usize = 1024;
@@ -151,7 +151,7 @@ pub fn predict_error<M: ShadowMapping + ?Sized>(
     }
     let errors = &mut errors[..count];
     errors.sort_unstable_by(f64::total_cmp);
-    let rank = (options.percentile * count as f64).ceil() as usize;
+    let rank = math::ceil(options.percentile * count as f64) as usize;
     Ok(Some(PredictedError {
         percentile: errors[rank.clamp(1, count) - 1],
         max: errors[count - 1],
@@ -290,11 +290,11 @@ fn plane_hit(origin: DVec3, dir: DVec3, point: DVec3, normal: DVec3) -> Option<D
 fn smaller_singular_value(a: DVec2, b: DVec2) -> f64 {
     let frobenius = a.length_squared() + b.length_squared();
     let det = a.perp_dot(b);
-    let root = (frobenius * frobenius - 4.0 * det * det).max(0.0).sqrt();
+    let root = math::sqrt((frobenius * frobenius - 4.0 * det * det).max(0.0));
     // s_min² = (F - root) / 2 = 2 det² / (F + root), the stable form.
     let denom = frobenius + root;
     if denom > 0.0 {
-        (2.0 * det * det / denom).sqrt()
+        math::sqrt(2.0 * det * det / denom)
     } else {
         0.0
     }

@@ -24,6 +24,7 @@
 
 use arrayvec::ArrayVec;
 use glam::DVec3;
+use shadowmap_frustum::math;
 
 /// Number of sample points: 3 cross-sections of 4 corners and a centre.
 const SAMPLES: usize = 15;
@@ -63,7 +64,7 @@ pub(crate) fn samples(l: DVec3, pts: &[DVec3; 8]) -> ArrayVec<Sample, SAMPLES> {
     // linearly with the quad size, so the ratio of sizes is the ratio of depths).
     let k = size_f / size_n.max(floor);
     let t_mid = if k.is_finite() {
-        1.0 / (k.sqrt() + 1.0)
+        1.0 / (math::sqrt(k) + 1.0)
     } else {
         0.5
     };
