@@ -103,7 +103,8 @@ pub use mapping::{
     LightDirection, ShadowMapping, ShadowSample, ShadowTransform, UV_FROM_CLIP, is_invertible,
 };
 pub use predict::{
-    MAX_PREDICT_RAYS, PredictOptions, PredictedError, TechniqueSelector, predict_error,
+    MAX_PREDICT_CANDIDATES, MAX_PREDICT_RAYS, PredictOptions, PredictedError, TechniqueSelector,
+    predict_error, predict_errors,
 };
 pub use split::{CascadeBlend, CascadeSplits, MAX_CASCADES, SplitScheme};
 pub use spot::{SpotShadow, fit_spot};

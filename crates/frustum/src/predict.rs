@@ -116,47 +116,102 @@ pub struct PredictedError {
 /// The camera's errors ([`Camera::frustum`]); [`FrustumError::EmptyBounds`] for an
 /// invalid or non-finite box; [`FrustumError::InvalidResolution`] for a zero map
 /// side or options out of range.
-pub fn predict_error<M: ShadowMapping + ?Sized>(
+pub fn predict_error<M: ShadowMapping>(
     camera: &Camera,
     receivers: &Aabb,
     mapping: &M,
     texels_per_side: u32,
     options: &PredictOptions,
 ) -> Result<Option<PredictedError>, FrustumError> {
+    let mut out = [None];
+    predict_errors(
+        camera,
+        receivers,
+        &[(mapping as &dyn ShadowMapping, texels_per_side)],
+        options,
+        &mut out,
+    )?;
+    Ok(out[0])
+}
+
+/// Most candidates [`predict_errors`] compares at once.
+pub const MAX_PREDICT_CANDIDATES: usize = 8;
+
+/// Predicts the error of several candidates `(mapping, texels per side)` on the same
+/// rays, for choosing among them: a ray counts only where every candidate covers its
+/// pixel, so a technique that covers less (cascades fitted to measured depth bounds,
+/// say) is not excused from points the others are charged for. When no ray is covered
+/// by all, each candidate is predicted on its own rays. Writes one prediction per
+/// candidate into `out` (`None`: the candidate covers none of the points met).
+///
+/// # Errors
+/// As [`predict_error`]; [`FrustumError::InvalidResolution`] also for more than
+/// [`MAX_PREDICT_CANDIDATES`] candidates or an `out` of another length.
+pub fn predict_errors(
+    camera: &Camera,
+    receivers: &Aabb,
+    candidates: &[(&dyn ShadowMapping, u32)],
+    options: &PredictOptions,
+    out: &mut [Option<PredictedError>],
+) -> Result<(), FrustumError> {
     options.check()?;
-    if texels_per_side == 0 {
+    let n = candidates.len();
+    if n > MAX_PREDICT_CANDIDATES || out.len() != n || candidates.iter().any(|c| c.1 == 0) {
         return Err(FrustumError::InvalidResolution);
     }
     if !(receivers.is_finite() && receivers.is_valid()) {
         return Err(FrustumError::EmptyBounds);
     }
     let screen = Screen::new(camera, options.viewport_height)?;
-    let texels = f64::from(texels_per_side);
-    let mut errors = [0.0f64; MAX_PREDICT_RAYS];
-    let mut count = 0usize;
-    for row in 0..options.grid_rows {
-        for column in 0..options.grid_columns {
-            let at = DVec2::new(
-                (f64::from(column) + 0.5) / f64::from(options.grid_columns),
-                (f64::from(row) + 0.5) / f64::from(options.grid_rows),
-            );
-            if let Some(m) = screen.error_at(at, receivers, mapping, texels) {
-                errors[count] = m;
-                count += 1;
+    let mut errors = [[0.0f64; MAX_PREDICT_RAYS]; MAX_PREDICT_CANDIDATES];
+    let mut counts = [0usize; MAX_PREDICT_CANDIDATES];
+    // Shared rays first; each candidate's own rays if no ray is shared.
+    for shared in [true, false] {
+        counts = [0; MAX_PREDICT_CANDIDATES];
+        for row in 0..options.grid_rows {
+            for column in 0..options.grid_columns {
+                let at = DVec2::new(
+                    (f64::from(column) + 0.5) / f64::from(options.grid_columns),
+                    (f64::from(row) + 0.5) / f64::from(options.grid_rows),
+                );
+                let mut ray = [None; MAX_PREDICT_CANDIDATES];
+                for (m, &(mapping, side)) in ray.iter_mut().zip(candidates) {
+                    *m = screen.error_at(at, receivers, mapping, f64::from(side));
+                }
+                if shared && ray[..n].iter().any(Option::is_none) {
+                    continue;
+                }
+                for (i, m) in ray[..n].iter().enumerate() {
+                    if let Some(m) = m {
+                        errors[i][counts[i]] = *m;
+                        counts[i] += 1;
+                    }
+                }
             }
         }
+        if !shared || counts[..n].iter().any(|&c| c > 0) {
+            break;
+        }
     }
+    for (i, slot) in out.iter_mut().enumerate() {
+        *slot = summarize(&mut errors[i][..counts[i]], options.percentile);
+    }
+    Ok(())
+}
+
+/// The percentile and maximum of the errors (sorted in place).
+fn summarize(errors: &mut [f64], percentile: f64) -> Option<PredictedError> {
+    let count = errors.len();
     if count == 0 {
-        return Ok(None);
+        return None;
     }
-    let errors = &mut errors[..count];
     errors.sort_unstable_by(f64::total_cmp);
-    let rank = math::ceil(options.percentile * count as f64) as usize;
-    Ok(Some(PredictedError {
+    let rank = math::ceil(percentile * count as f64) as usize;
+    Some(PredictedError {
         percentile: errors[rank.clamp(1, count) - 1],
         max: errors[count - 1],
         rays: count as u32,
-    }))
+    })
 }
 
 /// The view frustum as a screen: rays by normalized screen position and the size of a
@@ -202,11 +257,11 @@ impl Screen {
 
     /// `m` where the ray through `at` meets the box, if it does and the mapping covers
     /// the pixel and its neighbours in one layer.
-    fn error_at<M: ShadowMapping + ?Sized>(
+    fn error_at(
         &self,
         at: DVec2,
         receivers: &Aabb,
-        mapping: &M,
+        mapping: &dyn ShadowMapping,
         texels: f64,
     ) -> Option<f64> {
         let (origin, step) = self.ray(at);
@@ -462,6 +517,46 @@ mod tests {
                 Err(FrustumError::InvalidResolution)
             );
         }
+    }
+
+    /// A mapping that covers only points nearer than `depth` in front of the camera.
+    struct NearOnly(ShadowTransform, f64);
+
+    impl ShadowMapping for NearOnly {
+        fn map_point(&self, world: glam::DVec3) -> Option<crate::ShadowSample> {
+            (-world.z < self.1)
+                .then(|| self.0.map_point(world))
+                .flatten()
+        }
+    }
+
+    #[test]
+    fn candidates_are_compared_on_the_rays_all_of_them_cover() {
+        let (c, g, map) = (camera(), ground(), overhead(250.0));
+        let near = NearOnly(map, 40.0);
+        let o = PredictOptions::default();
+        let mut out = [None; 2];
+        predict_errors(&c, &g, &[(&map, 1024), (&near, 1024)], &o, &mut out).unwrap();
+        let (all, near_only) = (out[0].unwrap(), out[1].unwrap());
+        // The same rays, the same mapping there: the same prediction.
+        assert_eq!(all, near_only);
+        let alone = predict_error(&c, &g, &map, 1024, &o).unwrap().unwrap();
+        assert!(all.rays < alone.rays, "{all:?} vs {alone:?}");
+        // No shared ray: each on its own rays.
+        let nowhere = NearOnly(map, 0.0);
+        predict_errors(&c, &g, &[(&map, 1024), (&nowhere, 1024)], &o, &mut out).unwrap();
+        assert_eq!(out, [Some(alone), None]);
+        // Too many candidates, or an output of another length.
+        let many = [(&map as &dyn ShadowMapping, 1024u32); MAX_PREDICT_CANDIDATES + 1];
+        let mut nine = [None; MAX_PREDICT_CANDIDATES + 1];
+        assert_eq!(
+            predict_errors(&c, &g, &many, &o, &mut nine),
+            Err(FrustumError::InvalidResolution)
+        );
+        assert_eq!(
+            predict_errors(&c, &g, &[(&map, 1024)], &o, &mut out),
+            Err(FrustumError::InvalidResolution)
+        );
     }
 
     #[test]
