@@ -31,7 +31,7 @@ use crate::EvalError;
 use crate::bvh::Bvh;
 use crate::mask::GBuffer;
 use crate::metrics::{SurfacePoint, is_front_lit};
-use crate::scene::{Mesh, Scene};
+use crate::scene::{Mesh, Scene, SplitMix64};
 
 /// Knobs shared by every configuration.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -557,7 +557,7 @@ pub fn sweep_configurations(
             continue;
         };
         let (min, max) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
-        let mut rng = SweepRng(options.seed ^ (0x5EE9_0000_0000 + s as u64));
+        let mut rng = SplitMix64::new(options.seed ^ (0x5EE9_0000_0000 + s as u64));
         let bvh = Bvh::build(&scene.mesh)?;
         for k in 0..count {
             let mut attempts = 0;
@@ -618,7 +618,7 @@ fn measurable(bvh: &Bvh, camera: &Camera, light: &Light) -> Result<bool, EvalErr
     Ok(2 * gbuffer.visible_count() >= pixels && 4 * front_lit >= pixels)
 }
 
-fn sweep_camera(rng: &mut SweepRng, min: DVec3, max: DVec3) -> (CameraPath, DVec3) {
+fn sweep_camera(rng: &mut SplitMix64, min: DVec3, max: DVec3) -> (CameraPath, DVec3) {
     let size = max - min;
     let eye = DVec3::new(
         rng.range(min.x, max.x),
@@ -647,7 +647,7 @@ fn sweep_camera(rng: &mut SweepRng, min: DVec3, max: DVec3) -> (CameraPath, DVec
     (path, forward)
 }
 
-fn sweep_light(rng: &mut SweepRng, k: usize, min: DVec3, max: DVec3, forward: DVec3) -> Light {
+fn sweep_light(rng: &mut SplitMix64, k: usize, min: DVec3, max: DVec3, forward: DVec3) -> Light {
     let size = max - min;
     let range = (2.0 * size.length()) as f32;
     match k % 3 {
@@ -734,24 +734,6 @@ fn describe_light(light: &Light) -> String {
         Light::Point { position: p, .. } => {
             format!("point light at ({:.1}, {:.1}, {:.1})", p.x, p.y, p.z)
         }
-    }
-}
-
-/// The sweep's random numbers (SplitMix64: small, deterministic, no dependency).
-struct SweepRng(u64);
-
-impl SweepRng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[lo, hi)`.
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
     }
 }
 

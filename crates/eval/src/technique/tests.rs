@@ -1,5 +1,5 @@
 //! Unit tests of the technique list, the budget and `auto`.
-use shadowmap_frustum::{PredictOptions, predict_error};
+use shadowmap_frustum::{PredictOptions, predict_errors};
 
 use super::*;
 
@@ -25,6 +25,24 @@ fn every_light_has_techniques() {
     assert!(!TechniqueKind::SpotFit.applies_to(&d));
 }
 
+/// A frame over one box that both casts and receives, without eye samples.
+fn frame_over<'a>(
+    camera: &'a Camera,
+    light: &'a Light,
+    b: shadowmap_frustum::Aabb,
+) -> FrameContext<'a> {
+    FrameContext {
+        camera,
+        light,
+        scene: SceneBounds {
+            receivers: b,
+            casters: b,
+        },
+        eye_samples: &[],
+        pixels_per_radian: 100.0,
+    }
+}
+
 #[test]
 fn auto_is_the_candidate_with_the_lowest_prediction() {
     let camera = Camera::look_to(
@@ -39,34 +57,39 @@ fn auto_is_the_candidate_with_the_lowest_prediction() {
     };
     let b =
         shadowmap_frustum::Aabb::new(Vec3::new(-300.0, 0.0, -320.0), Vec3::new(300.0, 30.0, 20.0));
-    let frame = FrameContext {
-        camera: &camera,
-        light: &light,
-        scene: SceneBounds {
-            receivers: b,
-            casters: b,
-        },
-        eye_samples: &[],
-        pixels_per_radian: 100.0,
-    };
+    let frame = frame_over(&camera, &light, b);
     let o = TechniqueOptions::default().with_texel_budget(256 * 256);
     let auto = Technique::build(TechniqueKind::Auto, &frame, &o).unwrap();
     assert_eq!(auto.kind(), TechniqueKind::Auto);
     assert!(AUTO_CANDIDATES.contains(&auto.chosen()));
-    let predicted = |t: &Technique| {
-        predict_error(&camera, &b, t, t.side, &PredictOptions::default())
-            .unwrap()
-            .unwrap()
-            .percentile
-    };
-    let chosen = Technique::build(auto.chosen(), &frame, &o).unwrap();
-    let best = AUTO_CANDIDATES
+    // The candidates predicted on the rays all of them cover, as `auto` does.
+    let fitted: Vec<Technique> = AUTO_CANDIDATES
         .iter()
         .filter_map(|k| Technique::build(*k, &frame, &o).ok())
-        .map(|t| predicted(&t))
+        .collect();
+    let candidates: Vec<(&dyn ShadowMapping, u32)> = fitted
+        .iter()
+        .map(|t| (t as &dyn ShadowMapping, t.side))
+        .collect();
+    let mut predicted = vec![None; candidates.len()];
+    predict_errors(
+        &camera,
+        &b,
+        &candidates,
+        &PredictOptions::default(),
+        &mut predicted,
+    )
+    .unwrap();
+    let best = predicted
+        .iter()
+        .map(|p| p.unwrap().percentile)
         .fold(f64::INFINITY, f64::min);
-    assert_eq!(predicted(&auto), predicted(&chosen));
-    assert_eq!(predicted(&chosen), best);
+    let chosen = fitted
+        .iter()
+        .position(|t| t.kind() == auto.chosen())
+        .unwrap();
+    assert_eq!(predicted[chosen].unwrap().percentile, best);
+    let chosen = &fitted[chosen];
     // A perspective view over open ground: a warp beats the uniform fit.
     assert_ne!(auto.chosen(), TechniqueKind::UniformFocused);
     let p = DVec3::new(1.0, 0.0, -20.0);
@@ -86,16 +109,7 @@ fn wrong_light_or_bad_frame_is_a_typed_error() {
         direction: Vec3::NEG_Y,
     };
     let b = shadowmap_frustum::Aabb::new(Vec3::splat(-50.0), Vec3::splat(50.0));
-    let frame = FrameContext {
-        camera: &camera,
-        light: &light,
-        scene: SceneBounds {
-            receivers: b,
-            casters: b,
-        },
-        eye_samples: &[],
-        pixels_per_radian: 100.0,
-    };
+    let frame = frame_over(&camera, &light, b);
     let o = TechniqueOptions::default().with_texel_budget(64 * 64);
     let err = Technique::build(TechniqueKind::IpsmExact, &frame, &o).unwrap_err();
     assert!(matches!(
@@ -108,13 +122,7 @@ fn wrong_light_or_bad_frame_is_a_typed_error() {
     // Receivers behind the camera: the warp crate's error, not a panic.
     let behind =
         shadowmap_frustum::Aabb::new(Vec3::new(-5.0, -5.0, 10.0), Vec3::new(5.0, 5.0, 20.0));
-    let frame = FrameContext {
-        scene: SceneBounds {
-            receivers: behind,
-            casters: behind,
-        },
-        ..frame
-    };
+    let frame = frame_over(&camera, &light, behind);
     // (Stable cascades have a documented fallback instead: the whole slice.)
     for kind in TechniqueKind::for_light(&light) {
         if matches!(
@@ -132,13 +140,7 @@ fn wrong_light_or_bad_frame_is_a_typed_error() {
     // A valid frame builds every directional technique within the budget.
     let t = Technique::build(
         TechniqueKind::StableCascades,
-        &FrameContext {
-            scene: SceneBounds {
-                receivers: b,
-                casters: b,
-            },
-            ..frame
-        },
+        &frame_over(&camera, &light, b),
         &o,
     )
     .unwrap();
