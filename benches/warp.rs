@@ -7,7 +7,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use shadowmap::frustum::{Aabb, Camera, CascadeSplits, Projection, SplitScheme};
 use shadowmap::warp::{
-    FocusBody, FocusScene, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
+    FocusBody, LispsmOptions, SceneBounds, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
     uniform_focused, warped_cascades, xpsm,
 };
 use std::hint::black_box;
@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 struct Setup {
     camera: Camera,
     light: Vec3,
-    scene: FocusScene,
+    scene: SceneBounds,
     splits: CascadeSplits,
 }
 
@@ -32,7 +32,7 @@ fn setup() -> Setup {
         Vec3::new(-600.0, -1.0, -600.0),
         Vec3::new(600.0, 0.0, 600.0),
     );
-    let scene = FocusScene::new(
+    let scene = SceneBounds::new(
         ground,
         ground.union(&Aabb::new(Vec3::ZERO, Vec3::splat(80.0))),
     );

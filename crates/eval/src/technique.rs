@@ -33,8 +33,8 @@ use shadowmap_rtw::{
     WarpOptions, subdivide_for_rtw,
 };
 use shadowmap_warp::{
-    FocusScene, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
-    uniform_focused, warped_cascades, xpsm,
+    LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm, uniform_focused,
+    warped_cascades, xpsm,
 };
 
 use crate::EvalError;
@@ -321,7 +321,7 @@ impl Technique {
         if kind == TechniqueKind::Auto {
             return Self::build_auto(frame, options);
         }
-        let focus = FocusScene::new(frame.scene.receivers, frame.scene.casters);
+        let focus = frame.scene;
         let camera = frame.camera;
         let direction = match *frame.light {
             Light::Directional { direction } => direction,

@@ -16,7 +16,7 @@ use shadowmap_frustum::{
 };
 use shadowmap_paraboloid::{MapOptions, ParaboloidMap};
 use shadowmap_rtw::{RtwShadow, WarpMaps};
-use shadowmap_warp::{FocusScene, UniformOptions, uniform_focused};
+use shadowmap_warp::{SceneBounds, UniformOptions, uniform_focused};
 
 /// World = clip (w = 1): `x, y` are NDC directly.
 fn ndc() -> MatrixProjector {
@@ -366,9 +366,9 @@ fn camera() -> Camera {
 
 const LIGHT: Vec3 = Vec3::new(0.4, -1.0, 0.3);
 
-fn focus(mesh: &Mesh) -> FocusScene {
+fn focus(mesh: &Mesh) -> SceneBounds {
     let b = mesh.bounds().unwrap();
-    FocusScene::new(b, b)
+    SceneBounds::new(b, b)
 }
 
 #[test]

@@ -9,7 +9,7 @@ use arbitrary::Unstructured;
 use glam::{DVec3, Vec3};
 use shadowmap_frustum::{Aabb, Camera, CascadeSplits, ConvexBody, ShadowTransform, SplitScheme};
 use shadowmap_warp::{
-    FocusScene, LispsmOptions, TsmOptions, UniformOptions, WarpError, XpsmOptions, lispsm, tsm,
+    LispsmOptions, SceneBounds, TsmOptions, UniformOptions, WarpError, XpsmOptions, lispsm, tsm,
     uniform_focused, warped_cascades, xpsm,
 };
 
@@ -26,7 +26,7 @@ pub struct WarpCase {
     /// Direction the light travels.
     pub light: Vec3,
     /// Receivers and casters.
-    pub scene: FocusScene,
+    pub scene: SceneBounds,
     /// LiSPSM strength.
     pub eta: f32,
     /// Depth convention of the shadow map.
@@ -99,7 +99,7 @@ pub fn warp_case(u: &mut Unstructured<'_>) -> GenResult<WarpCase> {
     Ok(WarpCase {
         camera,
         light,
-        scene: FocusScene::new(receivers, casters),
+        scene: SceneBounds::new(receivers, casters),
         eta,
         reversed_z: u.arbitrary()?,
     })

@@ -4,7 +4,7 @@ use arrayvec::ArrayVec;
 use glam::Vec3;
 use shadowmap_frustum::{Camera, CascadeSplits, MAX_CASCADES};
 
-use crate::{FocusBody, FocusScene, LispsmOptions, LispsmShadow, WarpError};
+use crate::{FocusBody, LispsmOptions, LispsmShadow, SceneBounds, WarpError};
 
 /// One cascade of a warped-cascade fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,7 +41,7 @@ pub struct WarpedCascades {
 pub fn warped_cascades(
     camera: &Camera,
     light_direction: Vec3,
-    scene: &FocusScene,
+    scene: &SceneBounds,
     splits: &CascadeSplits,
     etas: &[f32],
     options: &LispsmOptions,

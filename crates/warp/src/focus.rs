@@ -4,38 +4,66 @@
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 use shadowmap_frustum::{
-    Aabb, Camera, ConvexBody, Frustum, LightDirection, MAX_BODY_VERTICES, ShadowTransform, math,
+    Aabb, Camera, ConvexBody, Frustum, LightDirection, MAX_BODY_VERTICES, SceneBounds,
+    ShadowTransform, math,
 };
 
 use crate::WarpError;
 
-/// What casts and what receives shadows, as world-space boxes.
-///
-/// `receivers` bounds every surface that must look up the map; `casters` bounds every
-/// surface that is drawn into it. Often both are the scene bounds
-/// ([`FocusScene::whole`]).
+/// Largest warp ratio `1 + s d` (near-to-far texel scale along the warp axis) a
+/// LiSPSM, TSM or XPSM fit uses; stronger warps are clamped to it so `f32` matrices
+/// keep precision. The warp strength `s` is also limited to `MAX_WARP_RATIO / L`, `L`
+/// the largest light-space coordinate of the focus body (the world's distance from
+/// its origin matters: render camera-relative to lift the limit).
+pub const MAX_WARP_RATIO: f64 = 1.0e4;
+
+/// The band of angles between the view and the light over which a warp fades to the
+/// uniform fit: full strength above `start_deg`, exactly uniform below `end_deg`, a
+/// cubic smoothstep of the sine of the angle in between, so the fit changes
+/// continuously as the light turns parallel to the view (where every perspective warp
+/// of a directional light degenerates; Filament guards the same case). Shared by
+/// LiSPSM and TSM.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FocusScene {
-    /// Bounds of the shadow receivers.
-    pub receivers: Aabb,
-    /// Bounds of the shadow casters.
-    pub casters: Aabb,
+pub struct ParallelFade {
+    /// Angle (degrees) between view and light above which the warp has full strength.
+    pub start_deg: f32,
+    /// Angle (degrees) below which the fit is exactly uniform.
+    pub end_deg: f32,
 }
 
-impl FocusScene {
-    /// Receivers and casters given separately.
+impl Default for ParallelFade {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+impl ParallelFade {
+    /// Fade between 10 and 3 degrees.
+    pub const DEFAULT: Self = Self {
+        start_deg: 10.0,
+        end_deg: 3.0,
+    };
+
+    /// A band from `start_deg` down to `end_deg`.
     #[must_use]
-    pub const fn new(receivers: Aabb, casters: Aabb) -> Self {
-        Self { receivers, casters }
+    pub const fn new(start_deg: f32, end_deg: f32) -> Self {
+        Self { start_deg, end_deg }
     }
 
-    /// One box that both casts and receives.
+    /// `0 <= end_deg < start_deg <= 90` (false for NaN).
     #[must_use]
-    pub const fn whole(scene: Aabb) -> Self {
-        Self {
-            receivers: scene,
-            casters: scene,
-        }
+    pub fn is_valid(&self) -> bool {
+        self.end_deg >= 0.0 && self.start_deg > self.end_deg && self.start_deg <= 90.0
+    }
+
+    /// Warp weight in `[0, 1]` for the sine of the angle between view and light.
+    pub(crate) fn weight(&self, sin_gamma: f64) -> f64 {
+        let deg = core::f64::consts::PI / 180.0;
+        smoothstep(
+            math::sin(f64::from(self.end_deg) * deg),
+            math::sin(f64::from(self.start_deg) * deg),
+            sin_gamma,
+        )
     }
 }
 
@@ -156,7 +184,7 @@ pub(crate) fn frame(light: DVec3, forward: DVec3, cam_up: DVec3) -> (DMat4, f64)
 }
 
 /// Checked scene boxes.
-pub(crate) fn check_scene(scene: &FocusScene) -> Result<(Aabb, Aabb), WarpError> {
+pub(crate) fn check_scene(scene: &SceneBounds) -> Result<(Aabb, Aabb), WarpError> {
     let (r, c) = (scene.receivers, scene.casters);
     if !(r.is_finite() && c.is_finite()) {
         return Err(WarpError::NonFinite);
@@ -202,7 +230,7 @@ impl Focus {
     }
 }
 
-pub(crate) fn focus(view: &View, light: Vec3, scene: &FocusScene) -> Result<Focus, WarpError> {
+pub(crate) fn focus(view: &View, light: Vec3, scene: &SceneBounds) -> Result<Focus, WarpError> {
     let dir = light_unit(light)?;
     let (receivers, casters) = check_scene(scene)?;
     let body = ConvexBody::from_frustum_aabb(&view.frustum, &receivers)?;
@@ -236,7 +264,7 @@ pub(crate) fn focus(view: &View, light: Vec3, scene: &FocusScene) -> Result<Focu
 /// ```
 /// use glam::Vec3;
 /// use shadowmap_frustum::{Aabb, Camera, Projection};
-/// use shadowmap_warp::{FocusBody, FocusScene, LispsmOptions, TsmOptions};
+/// use shadowmap_warp::{FocusBody, SceneBounds, LispsmOptions, TsmOptions};
 ///
 /// let camera = Camera::look_to(
 ///     Vec3::new(0.0, 2.0, 0.0),
@@ -244,7 +272,7 @@ pub(crate) fn focus(view: &View, light: Vec3, scene: &FocusScene) -> Result<Focu
 ///     Vec3::Y,
 ///     Projection::perspective(1.0, 1.5, 0.5, 100.0),
 /// )?;
-/// let scene = FocusScene::whole(Aabb::new(Vec3::splat(-50.0), Vec3::splat(50.0)));
+/// let scene = SceneBounds::whole(Aabb::new(Vec3::splat(-50.0), Vec3::splat(50.0)));
 /// let body = FocusBody::new(&camera, Vec3::new(0.3, -1.0, -0.2), &scene)?;
 /// let l = body.lispsm(&LispsmOptions::default())?;
 /// let t = body.tsm(&TsmOptions::default())?;
@@ -268,7 +296,7 @@ impl FocusBody {
     pub fn new(
         camera: &Camera,
         light_direction: Vec3,
-        scene: &FocusScene,
+        scene: &SceneBounds,
     ) -> Result<Self, WarpError> {
         let view = View::camera(camera)?;
         let focus = focus(&view, light_direction, scene)?;
@@ -286,7 +314,7 @@ impl FocusBody {
         near: f32,
         far: f32,
         light_direction: Vec3,
-        scene: &FocusScene,
+        scene: &SceneBounds,
     ) -> Result<Self, WarpError> {
         let view = View::with_frustum(camera, camera.slice(near, far)?)?;
         let focus = focus(&view, light_direction, scene)?;

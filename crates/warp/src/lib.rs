@@ -28,7 +28,7 @@
 //! ```
 //! use glam::Vec3;
 //! use shadowmap_frustum::{Aabb, Camera, Projection};
-//! use shadowmap_warp::{FocusScene, LispsmOptions, UniformOptions, lispsm, uniform_focused};
+//! use shadowmap_warp::{SceneBounds, LispsmOptions, UniformOptions, lispsm, uniform_focused};
 //!
 //! let camera = Camera::look_to(
 //!     Vec3::new(0.0, 2.0, 0.0),
@@ -36,7 +36,7 @@
 //!     Vec3::Y,
 //!     Projection::perspective(60f32.to_radians(), 16.0 / 9.0, 0.5, 100.0),
 //! )?;
-//! let scene = FocusScene::whole(Aabb::new(Vec3::new(-100.0, 0.0, -120.0), Vec3::new(100.0, 20.0, 10.0)));
+//! let scene = SceneBounds::whole(Aabb::new(Vec3::new(-100.0, 0.0, -120.0), Vec3::new(100.0, 20.0, 10.0)));
 //! let light = Vec3::new(0.3, -1.0, -0.2);
 //!
 //! let uniform = uniform_focused(&camera, light, &scene, &UniformOptions::default())?;
@@ -91,8 +91,8 @@
 //! none of which is an error:
 //!
 //! - light parallel to the view direction: the warp fades smoothly to the uniform
-//!   fit (LiSPSM between [`LispsmOptions::fade_start_deg`] and
-//!   [`LispsmOptions::fade_end_deg`], TSM likewise; XPSM's miner's-lamp case below
+//!   fit over a [`ParallelFade`] band (LiSPSM's and TSM's `fade` option; XPSM's
+//!   miner's-lamp case below
 //!   [`XpsmOptions::miner_lamp_threshold`]), and the light frame stays continuous
 //!   (see below); the warp axis never points away from the viewer while a warp has
 //!   strength. Measured in this crate's tests (a level camera 2 m above a ground
@@ -146,16 +146,17 @@ mod error;
 mod focus;
 mod lispsm;
 mod tsm;
+mod uniform;
 mod xpsm;
 
 pub use cascades::{WarpedCascade, WarpedCascades, warped_cascades};
 pub use error::WarpError;
-pub use focus::{FocusBody, FocusScene, MAX_MAP_SIDE, MIN_RELATIVE_EXTENT};
-pub use lispsm::{
-    LispsmOptions, LispsmShadow, MAX_WARP_RATIO, UniformOptions, lispsm, uniform_focused,
-};
+pub use focus::{FocusBody, MAX_MAP_SIDE, MAX_WARP_RATIO, MIN_RELATIVE_EXTENT, ParallelFade};
+pub use lispsm::{LispsmOptions, LispsmShadow, lispsm};
+pub use shadowmap_frustum::SceneBounds;
 pub use shadowmap_frustum::{ShadowTransform, glam};
 pub use tsm::{TsmOptions, TsmShadow, tsm};
+pub use uniform::{UniformOptions, uniform_focused};
 pub use xpsm::{XpsmOptions, XpsmShadow, xpsm};
 
 use glam::{Mat4, Vec3};

@@ -1,49 +1,14 @@
-//! Uniform focused and light space perspective shadow maps (LiSPSM).
+//! Light space perspective shadow maps (LiSPSM).
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap_frustum::{Camera, ShadowTransform, math};
 
 use crate::WarpError;
 use crate::focus::{
-    Bounds, Focus, FocusBody, FocusScene, View, finish, footprint_weight, ortho_fit, scale_of,
-    smoothstep, sqrt0, transform_points,
+    Bounds, Focus, FocusBody, View, finish, footprint_weight, ortho_fit, scale_of, sqrt0,
+    transform_points,
 };
-
-/// Largest warp ratio `1 + s d` (near-to-far texel scale along the warp axis) a
-/// LiSPSM, TSM or XPSM fit uses; stronger warps are clamped to it so `f32` matrices
-/// keep precision. The warp strength `s` is also limited to `MAX_WARP_RATIO / L`, `L`
-/// the largest light-space coordinate of the focus body (the world's distance from
-/// its origin matters: render camera-relative to lift the limit).
-pub const MAX_WARP_RATIO: f64 = 1.0e4;
-
-/// Options of [`uniform_focused`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-pub struct UniformOptions {
-    /// Depth 1 at the light's near plane and 0 at its far plane.
-    pub reversed_z: bool,
-}
-
-impl Default for UniformOptions {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl UniformOptions {
-    /// Standard depth.
-    #[must_use]
-    pub const fn new() -> Self {
-        Self { reversed_z: false }
-    }
-
-    /// Sets [`reversed_z`](Self::reversed_z).
-    #[must_use]
-    pub const fn with_reversed_z(mut self, reversed_z: bool) -> Self {
-        self.reversed_z = reversed_z;
-        self
-    }
-}
+use crate::{MAX_WARP_RATIO, ParallelFade, SceneBounds};
 
 /// Options of [`lispsm`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,12 +26,9 @@ pub struct LispsmOptions {
     /// `min(z_far, far_hint)`. Default infinity (none). Must not be below
     /// [`near_hint`](Self::near_hint) ([`WarpError::InvalidOption`]).
     pub far_hint: f32,
-    /// Angle (degrees) between view and light direction above which the warp has full
-    /// strength. Default 10.
-    pub fade_start_deg: f32,
-    /// Angle (degrees) below which the fit is exactly uniform. Default 3. Must be
-    /// below [`fade_start_deg`](Self::fade_start_deg).
-    pub fade_end_deg: f32,
+    /// The parallel-light fade band (default: full strength above 10 degrees,
+    /// uniform below 3).
+    pub fade: ParallelFade,
 }
 
 impl Default for LispsmOptions {
@@ -84,8 +46,7 @@ impl LispsmOptions {
             eta: 0.0,
             near_hint: 0.0,
             far_hint: f32::INFINITY,
-            fade_start_deg: 10.0,
-            fade_end_deg: 3.0,
+            fade: ParallelFade::DEFAULT,
         }
     }
 
@@ -114,8 +75,7 @@ impl LispsmOptions {
     /// Sets the parallel-light fade band, in degrees (`end < start`).
     #[must_use]
     pub const fn with_fade(mut self, start_deg: f32, end_deg: f32) -> Self {
-        self.fade_start_deg = start_deg;
-        self.fade_end_deg = end_deg;
+        self.fade = ParallelFade::new(start_deg, end_deg);
         self
     }
 
@@ -125,9 +85,7 @@ impl LispsmOptions {
             && self.near_hint.is_finite()
             && self.far_hint > 0.0
             && self.far_hint >= self.near_hint
-            && self.fade_end_deg >= 0.0
-            && self.fade_start_deg > self.fade_end_deg
-            && self.fade_start_deg <= 90.0;
+            && self.fade.is_valid();
         if ok {
             Ok(())
         } else {
@@ -148,30 +106,6 @@ pub struct LispsmShadow {
     pub fade: f32,
 }
 
-/// Uniform focused shadow map of a directional light (the baseline every other
-/// technique is compared with).
-///
-/// An orthographic projection in the light frame (see [`light_frame`](crate::light_frame))
-/// fitted to frustum ∩ receivers, its near plane pulled back to the casters that can
-/// shadow them (the body extruded toward the light, clipped by
-/// `casters ∪ receivers`).
-///
-/// # Errors
-/// [`WarpError::Frustum`] for an invalid camera; [`WarpError::NonFinite`],
-/// [`WarpError::ZeroDirection`] for the light; [`WarpError::EmptyReceivers`],
-/// [`WarpError::EmptyCasters`] for inverted boxes; [`WarpError::NoVisibleReceivers`]
-/// when the receivers miss the frustum; [`WarpError::Degenerate`] when the `f32`
-/// result would be singular or non-finite. A focus region of zero area (a point or
-/// line of receivers) is widened (see the crate docs), not refused.
-pub fn uniform_focused(
-    camera: &Camera,
-    light_direction: Vec3,
-    scene: &FocusScene,
-    options: &UniformOptions,
-) -> Result<ShadowTransform, WarpError> {
-    FocusBody::new(camera, light_direction, scene)?.uniform(options)
-}
-
 /// Light space perspective shadow map (Wimmer, Scherzer and Purgathofer 2004) with the
 /// strength parameter of Lloyd et al. (2006).
 ///
@@ -180,7 +114,7 @@ pub fn uniform_focused(
 pub fn lispsm(
     camera: &Camera,
     light_direction: Vec3,
-    scene: &FocusScene,
+    scene: &SceneBounds,
     options: &LispsmOptions,
 ) -> Result<LispsmShadow, WarpError> {
     options.check()?;
@@ -188,14 +122,6 @@ pub fn lispsm(
 }
 
 impl FocusBody {
-    /// The uniform focused fit of this body (see [`uniform_focused`]).
-    ///
-    /// # Errors
-    /// [`WarpError::Degenerate`] when the `f32` result would be singular.
-    pub fn uniform(&self, options: &UniformOptions) -> Result<ShadowTransform, WarpError> {
-        warp_fit(&self.focus, &self.view, 0.0, options.reversed_z).map(|(t, _)| t)
-    }
-
     /// The LiSPSM fit of this body (see [`lispsm`]).
     ///
     /// # Errors
@@ -218,12 +144,7 @@ impl FocusBody {
 
 /// The warp strength `s = 1/n` and the fade weight.
 fn warp_strength(f: &Focus, view: &View, o: &LispsmOptions) -> (f64, f64) {
-    let deg = core::f64::consts::PI / 180.0;
-    let fade = smoothstep(
-        math::sin(f64::from(o.fade_end_deg) * deg),
-        math::sin(f64::from(o.fade_start_deg) * deg),
-        f.sin_gamma,
-    );
+    let fade = o.fade.weight(f.sin_gamma);
     let hints = (f64::from(o.near_hint), f64::from(o.far_hint));
     (strength(f, view, f64::from(o.eta), hints, fade), fade)
 }
@@ -336,6 +257,7 @@ mod tests {
     use shadowmap_frustum::{Aabb, Camera, Projection, ShadowMapping, ShadowTransform};
 
     use super::*;
+    use crate::{UniformOptions, uniform_focused};
 
     /// Texel density (texture units per world unit) along the view axis and across
     /// it, at view depth `z`, by central differences.
@@ -353,7 +275,7 @@ mod tests {
     fn storage_factor(
         camera: &Camera,
         light: Vec3,
-        scene: &FocusScene,
+        scene: &SceneBounds,
         eta: f32,
         n: f64,
         f: f64,
@@ -397,7 +319,7 @@ mod tests {
         )
         .unwrap();
         // Receivers and casters hold the whole frustum, so the body is the frustum.
-        let scene = FocusScene::whole(Aabb::new(
+        let scene = SceneBounds::whole(Aabb::new(
             Vec3::new(-800.0, -800.0, -1100.0),
             Vec3::new(800.0, 800.0, 10.0),
         ));
@@ -471,7 +393,7 @@ mod tests {
             Projection::perspective(1.0, 1.0, 0.1, 10.0),
         )
         .unwrap();
-        let scene = FocusScene::whole(Aabb::new(Vec3::splat(-20.0), Vec3::splat(20.0)));
+        let scene = SceneBounds::whole(Aabb::new(Vec3::splat(-20.0), Vec3::splat(20.0)));
         for o in [
             LispsmOptions::default().with_eta(1.5),
             LispsmOptions::default().with_eta(f32::NAN),
@@ -499,17 +421,17 @@ mod tests {
             .err(),
             Some(WarpError::NonFinite)
         );
-        let inverted = FocusScene::new(Aabb::new(Vec3::ONE, Vec3::ZERO), scene.casters);
+        let inverted = SceneBounds::new(Aabb::new(Vec3::ONE, Vec3::ZERO), scene.casters);
         assert_eq!(
             uniform_focused(&camera, Vec3::NEG_Y, &inverted, &UniformOptions::default()).err(),
             Some(WarpError::EmptyReceivers)
         );
-        let inverted = FocusScene::new(scene.receivers, Aabb::new(Vec3::ONE, Vec3::ZERO));
+        let inverted = SceneBounds::new(scene.receivers, Aabb::new(Vec3::ONE, Vec3::ZERO));
         assert_eq!(
             uniform_focused(&camera, Vec3::NEG_Y, &inverted, &UniformOptions::default()).err(),
             Some(WarpError::EmptyCasters)
         );
-        let away = FocusScene::whole(Aabb::new(Vec3::splat(100.0), Vec3::splat(101.0)));
+        let away = SceneBounds::whole(Aabb::new(Vec3::splat(100.0), Vec3::splat(101.0)));
         assert_eq!(
             uniform_focused(&camera, Vec3::NEG_Y, &away, &UniformOptions::default()).err(),
             Some(WarpError::NoVisibleReceivers)

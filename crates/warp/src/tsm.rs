@@ -2,12 +2,13 @@
 
 use arrayvec::ArrayVec;
 use glam::Vec3;
-use shadowmap_frustum::{Camera, MAX_BODY_VERTICES, ShadowTransform, math};
+use shadowmap_frustum::{Camera, MAX_BODY_VERTICES, ShadowTransform};
 
 use crate::FocusBody;
-use crate::focus::{Focus, FocusScene, View, smoothstep};
+use crate::focus::{Focus, View};
 use crate::lispsm::warp_fit;
 use crate::{MAX_WARP_RATIO, WarpError};
+use crate::{ParallelFade, SceneBounds};
 
 /// Options of [`tsm`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -19,12 +20,9 @@ pub struct TsmOptions {
     /// receivers' view-depth range: the region up to it gets 80% of the map (the
     /// "80% rule"). Default 0.1.
     pub focus: f32,
-    /// Angle (degrees) between view and light above which the trapezoid has full
-    /// strength. Default 10.
-    pub fade_start_deg: f32,
-    /// Angle (degrees) below which the fit is exactly uniform (the trapezoid is a
-    /// rectangle). Default 3.
-    pub fade_end_deg: f32,
+    /// The parallel-light fade band (default: full strength above 10 degrees,
+    /// uniform below 3).
+    pub fade: ParallelFade,
 }
 
 impl Default for TsmOptions {
@@ -40,8 +38,7 @@ impl TsmOptions {
         Self {
             reversed_z: false,
             focus: 0.1,
-            fade_start_deg: 10.0,
-            fade_end_deg: 3.0,
+            fade: ParallelFade::DEFAULT,
         }
     }
 
@@ -62,17 +59,12 @@ impl TsmOptions {
     /// Sets the parallel-light fade band, in degrees (`end < start`).
     #[must_use]
     pub const fn with_fade(mut self, start_deg: f32, end_deg: f32) -> Self {
-        self.fade_start_deg = start_deg;
-        self.fade_end_deg = end_deg;
+        self.fade = ParallelFade::new(start_deg, end_deg);
         self
     }
 
     fn check(&self) -> Result<(), WarpError> {
-        let ok = self.focus > 0.0
-            && self.focus < 1.0
-            && self.fade_end_deg >= 0.0
-            && self.fade_start_deg > self.fade_end_deg
-            && self.fade_start_deg <= 90.0;
+        let ok = self.focus > 0.0 && self.focus < 1.0 && self.fade.is_valid();
         if ok {
             Ok(())
         } else {
@@ -121,7 +113,7 @@ pub struct TsmShadow {
 pub fn tsm(
     camera: &Camera,
     light_direction: Vec3,
-    scene: &FocusScene,
+    scene: &SceneBounds,
     options: &TsmOptions,
 ) -> Result<TsmShadow, WarpError> {
     options.check()?;
@@ -140,12 +132,7 @@ impl FocusBody {
 }
 
 fn tsm_body(view: &View, f: &Focus, options: &TsmOptions) -> Result<TsmShadow, WarpError> {
-    let deg = core::f64::consts::PI / 180.0;
-    let fade = smoothstep(
-        math::sin(f64::from(options.fade_end_deg) * deg),
-        math::sin(f64::from(options.fade_start_deg) * deg),
-        f.sin_gamma,
-    );
+    let fade = options.fade.weight(f.sin_gamma);
     // Top and base edges: the receivers' extent along the centre line.
     let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
     let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -220,7 +207,7 @@ mod tests {
             Projection::perspective(60f32.to_radians(), 1.0, 1.0, 1000.0),
         )
         .unwrap();
-        let scene = FocusScene::whole(Aabb::new(
+        let scene = SceneBounds::whole(Aabb::new(
             Vec3::new(-800.0, -800.0, -1100.0),
             Vec3::new(800.0, 800.0, 10.0),
         ));

@@ -207,7 +207,7 @@ type Cloud = ArrayVec<Hom, 1100>;
 pub fn xpsm(
     camera: &Camera,
     light_direction: Vec3,
-    scene: &crate::FocusScene,
+    scene: &crate::SceneBounds,
     options: &XpsmOptions,
 ) -> Result<XpsmShadow, WarpError> {
     options.validate()?;
@@ -489,7 +489,7 @@ mod tests {
     use shadowmap_frustum::{Aabb, Camera, Projection, ShadowMapping};
 
     use super::*;
-    use crate::FocusScene;
+    use crate::SceneBounds;
 
     fn camera() -> Camera {
         Camera::look_to(
@@ -504,7 +504,7 @@ mod tests {
     #[test]
     fn miner_lamp_is_orthographic() {
         let cam = camera();
-        let scene = FocusScene::whole(Aabb::new(Vec3::splat(-150.0), Vec3::splat(150.0)));
+        let scene = SceneBounds::whole(Aabb::new(Vec3::splat(-150.0), Vec3::splat(150.0)));
         let x = xpsm(&cam, cam.forward(), &scene, &XpsmOptions::default()).unwrap();
         assert_eq!(x.warp_weight, 0.0);
         assert_eq!(x.length_p, 0.0);
@@ -525,7 +525,7 @@ mod tests {
             Vec3::new(-100.0, -1.0, -100.0),
             Vec3::new(100.0, 30.0, 400.0),
         );
-        let scene = FocusScene::new(receivers, casters);
+        let scene = SceneBounds::new(receivers, casters);
         let light = Vec3::new(0.1, -0.6, -1.0);
         let o = XpsmOptions::default().with_coef(10.0);
         let x = xpsm(&cam, light, &scene, &o).unwrap();
@@ -546,7 +546,7 @@ mod tests {
             );
         }
         // Without the casters behind, the same coef is not clipped.
-        let front = FocusScene::new(
+        let front = SceneBounds::new(
             receivers,
             Aabb::new(receivers.min, Vec3::new(100.0, 30.0, 0.0)),
         );
@@ -562,7 +562,7 @@ mod tests {
         let r = xpsm(
             &cam,
             Vec3::NEG_Y,
-            &FocusScene::new(receivers, casters),
+            &SceneBounds::new(receivers, casters),
             &XpsmOptions::default(),
         );
         assert_eq!(r.err(), Some(WarpError::EmptyFocusRegion));
@@ -570,7 +570,7 @@ mod tests {
             XpsmOptions::default().with_epsilon_w(0.0),
             XpsmOptions::default().with_coef(f32::NAN),
         ] {
-            let r = xpsm(&cam, Vec3::NEG_Y, &FocusScene::whole(receivers), &bad);
+            let r = xpsm(&cam, Vec3::NEG_Y, &SceneBounds::whole(receivers), &bad);
             assert_eq!(r.err(), Some(WarpError::InvalidOption));
         }
     }

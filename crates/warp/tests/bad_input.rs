@@ -5,7 +5,7 @@
 use glam::{DVec3, Vec3, Vec4};
 use shadowmap_frustum::{Aabb, Camera, Projection, ShadowMapping, ShadowTransform, is_invertible};
 use shadowmap_warp::{
-    FocusScene, LispsmOptions, MAX_MAP_SIDE, TsmOptions, UniformOptions, WarpError, XpsmOptions,
+    LispsmOptions, MAX_MAP_SIDE, SceneBounds, TsmOptions, UniformOptions, WarpError, XpsmOptions,
     lispsm, tsm, uniform_focused, xpsm,
 };
 
@@ -23,7 +23,7 @@ fn camera(eye: Vec3) -> Camera {
 fn all(
     cam: &Camera,
     light: Vec3,
-    scene: &FocusScene,
+    scene: &SceneBounds,
     xo: &XpsmOptions,
 ) -> [(&'static str, Result<ShadowTransform, WarpError>); 4] {
     [
@@ -58,7 +58,7 @@ fn huge_casters_and_tiny_epsilon_w_give_invertible_matrices_or_degenerate() {
         for light in [Vec3::new(0.3, -1.0, -0.4), Vec3::new(0.1, -0.6, 1.0)] {
             for eps_w in [0.1f32, 1e-7] {
                 let xo = XpsmOptions::default().with_epsilon_w(eps_w);
-                for (name, r) in all(&cam, light, &FocusScene::new(ground, tall), &xo) {
+                for (name, r) in all(&cam, light, &SceneBounds::new(ground, tall), &xo) {
                     match r {
                         Ok(t) => {
                             assert!(
@@ -97,7 +97,7 @@ fn tiny_receivers_keep_texels_resolvable_in_f32() {
         let casters = Aabb::new(origin - Vec3::splat(50.0), origin + Vec3::splat(50.0));
         for width in [0.0f32, 1e-6, 1e-3] {
             let receivers = Aabb::new(origin, origin + Vec3::splat(width));
-            let scene = FocusScene::new(receivers, casters);
+            let scene = SceneBounds::new(receivers, casters);
             let mut checked = 0;
             for (name, r) in all(
                 &cam,
@@ -125,7 +125,7 @@ fn tiny_receivers_keep_texels_resolvable_in_f32() {
 #[test]
 fn inverted_hints_are_refused() {
     let cam = camera(Vec3::new(0.0, 2.0, 0.0));
-    let scene = FocusScene::whole(Aabb::new(Vec3::splat(-50.0), Vec3::splat(50.0)));
+    let scene = SceneBounds::whole(Aabb::new(Vec3::splat(-50.0), Vec3::splat(50.0)));
     let r = lispsm(
         &cam,
         Vec3::NEG_Y,

@@ -5,7 +5,7 @@ use glam::{DVec3, Vec3};
 use proptest::prelude::*;
 use shadowmap_frustum::{Aabb, Camera, CascadeSplits, Projection, ShadowTransform, SplitScheme};
 use shadowmap_warp::{
-    FocusScene, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
+    LispsmOptions, SceneBounds, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
     uniform_focused, warped_cascades, xpsm,
 };
 
@@ -16,7 +16,7 @@ const NAMES: [&str; 5] = ["uniform", "lispsm", "tsm", "xpsm", "warped_cascades"]
 
 struct Rig {
     camera: Camera,
-    scene: FocusScene,
+    scene: SceneBounds,
     /// A near and a far ground point in view.
     fixed: [Vec3; 2],
     /// Ground points spread over the view frustum.
@@ -68,7 +68,7 @@ fn rig_looking(height: f32, forward: Vec3) -> Rig {
         .unwrap();
     Rig {
         camera,
-        scene: FocusScene::new(ground, casters),
+        scene: SceneBounds::new(ground, casters),
         fixed: [near, far],
         grid,
     }

@@ -7,7 +7,7 @@ use std::alloc::System;
 use glam::Vec3;
 use shadowmap_frustum::{Aabb, Camera, CascadeSplits, Projection, SplitScheme};
 use shadowmap_warp::{
-    FocusBody, FocusScene, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
+    FocusBody, LispsmOptions, SceneBounds, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
     uniform_focused, warped_cascades, xpsm,
 };
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
@@ -25,7 +25,7 @@ fn per_frame_path_does_not_allocate() {
     )
     .unwrap();
     let ground = Aabb::new(Vec3::new(-200.0, -1.0, -300.0), Vec3::new(200.0, 0.0, 10.0));
-    let scene = FocusScene::new(
+    let scene = SceneBounds::new(
         ground,
         ground.union(&Aabb::new(Vec3::ZERO, Vec3::splat(40.0))),
     );

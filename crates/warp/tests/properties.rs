@@ -405,7 +405,7 @@ fn xpsm_z_bias_matches_the_paper() {
         shadowmap_frustum::Projection::perspective(1.0, 1.5, 0.5, 200.0),
     )
     .unwrap();
-    let scene = shadowmap_warp::FocusScene::whole(shadowmap_frustum::Aabb::new(
+    let scene = shadowmap_warp::SceneBounds::whole(shadowmap_frustum::Aabb::new(
         Vec3::new(-300.0, 0.0, -300.0),
         Vec3::new(300.0, 30.0, 50.0),
     ));
@@ -459,7 +459,7 @@ fn sweep(technique: usize, from: f32, to: f32, step: f32) -> f64 {
         shadowmap_frustum::Projection::perspective(1.0, 1.5, 0.5, 100.0),
     )
     .unwrap();
-    let scene = shadowmap_warp::FocusScene::whole(shadowmap_frustum::Aabb::new(
+    let scene = shadowmap_warp::SceneBounds::whole(shadowmap_frustum::Aabb::new(
         Vec3::new(-200.0, -1.0, -200.0),
         Vec3::new(200.0, 5.0, 20.0),
     ));
@@ -526,7 +526,7 @@ fn lispsm_is_uniform_below_the_fade() {
         shadowmap_frustum::Projection::perspective(1.0, 1.5, 0.5, 100.0),
     )
     .unwrap();
-    let scene = shadowmap_warp::FocusScene::whole(shadowmap_frustum::Aabb::new(
+    let scene = shadowmap_warp::SceneBounds::whole(shadowmap_frustum::Aabb::new(
         Vec3::new(-200.0, -1.0, -200.0),
         Vec3::new(200.0, 5.0, 20.0),
     ));

@@ -11,7 +11,7 @@ use shadowmap_frustum::{
 };
 use shadowmap_paraboloid::{MapOptions, ParaboloidMap};
 use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
-use shadowmap_warp::{FocusScene, UniformOptions, XpsmOptions, uniform_focused, xpsm};
+use shadowmap_warp::{SceneBounds, UniformOptions, XpsmOptions, uniform_focused, xpsm};
 use shadowmap_wgpu::GpuContext;
 use shadowmap_wgpu::depth::{
     DepthPassDesc, DepthTechnique, DepthUniforms, MeshBuffers, RtwSubdivision, ShadowDepthPass,
@@ -32,7 +32,7 @@ fn camera() -> Camera {
 fn packing(c: &mut Criterion) {
     let cam = camera();
     let light = Vec3::new(0.4, -1.0, 0.3);
-    let scene = FocusScene::whole(Aabb::new(
+    let scene = SceneBounds::whole(Aabb::new(
         Vec3::new(-200.0, 0.0, -200.0),
         Vec3::new(200.0, 60.0, 200.0),
     ));

@@ -15,7 +15,7 @@ use shadowmap_frustum::{
 use shadowmap_paraboloid::{MapOptions, ParaboloidMap};
 use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
 use shadowmap_warp::{
-    FocusScene, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
+    LispsmOptions, SceneBounds, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
     uniform_focused, xpsm,
 };
 use shadowmap_wgpu::GpuContext;
@@ -31,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|t| t.map(glam::DVec3::as_vec3))
         .collect();
     let bounds = scene.bounds().ok_or("empty scene")?;
-    let focus = FocusScene::whole(bounds);
+    let focus = SceneBounds::whole(bounds);
     let camera = Camera::look_at(
         Vec3::new(-20.0, 25.0, 110.0),
         Vec3::new(0.0, 0.0, 0.0),

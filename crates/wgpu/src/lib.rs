@@ -25,14 +25,14 @@
 //! ```no_run
 //! use glam::Vec3;
 //! use shadowmap_frustum::{Aabb, Camera, Projection};
-//! use shadowmap_warp::{FocusScene, UniformOptions, uniform_focused};
+//! use shadowmap_warp::{SceneBounds, UniformOptions, uniform_focused};
 //! use shadowmap_wgpu::depth::{DepthPassDesc, DepthTechnique, DepthUniforms, MeshBuffers, ShadowDepthPass};
 //! use shadowmap_wgpu::{GpuContext, uniforms::ToRaw};
 //!
 //! let ctx = GpuContext::new_headless()?;
 //! let camera = Camera::look_at(Vec3::new(0.0, 5.0, 15.0), Vec3::ZERO, Vec3::Y,
 //!     Projection::perspective(1.0, 1.0, 0.5, 50.0)).unwrap();
-//! let scene = FocusScene::whole(Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0)));
+//! let scene = SceneBounds::whole(Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0)));
 //! let light = uniform_focused(&camera, Vec3::new(0.3, -1.0, 0.2), &scene, &UniformOptions::default()).unwrap();
 //!
 //! let caster = MeshBuffers::from_triangles(&ctx, &[[Vec3::ZERO, Vec3::X, Vec3::Y]])?;

@@ -15,7 +15,7 @@
 //! ```no_run
 //! use glam::Vec3;
 //! use shadowmap_frustum::{Aabb, Camera, Projection};
-//! use shadowmap_warp::{FocusScene, UniformOptions, uniform_focused};
+//! use shadowmap_warp::{SceneBounds, UniformOptions, uniform_focused};
 //! use shadowmap_wgpu::GpuContext;
 //! use shadowmap_wgpu::render::{HeadlessRenderer, RenderOptions, ShadowTechnique};
 //!
@@ -23,7 +23,7 @@
 //! let ground = [[Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 0.0, -10.0), Vec3::new(0.0, 0.0, 10.0)]];
 //! let camera = Camera::look_at(Vec3::new(0.0, 5.0, 15.0), Vec3::ZERO, Vec3::Y,
 //!     Projection::perspective(1.0, 1.0, 0.5, 50.0)).unwrap();
-//! let scene = FocusScene::whole(Aabb::new(Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 1.0, 10.0)));
+//! let scene = SceneBounds::whole(Aabb::new(Vec3::new(-10.0, 0.0, -10.0), Vec3::new(10.0, 1.0, 10.0)));
 //! let light = uniform_focused(&camera, Vec3::new(0.3, -1.0, 0.2), &scene, &UniformOptions::default()).unwrap();
 //! let mut renderer = HeadlessRenderer::new();
 //! let frame = renderer.render(&ctx, &ground, &camera, &ShadowTechnique::Matrix(&light), &RenderOptions::default())?;

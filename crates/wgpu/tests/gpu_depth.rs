@@ -15,7 +15,7 @@ use shadowmap_paraboloid::{
 };
 use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
 use shadowmap_warp::{
-    FocusScene, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
+    LispsmOptions, SceneBounds, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
     uniform_focused, xpsm,
 };
 use shadowmap_wgpu::GpuContext;
@@ -57,8 +57,8 @@ fn mesh_of(tris: &[[Vec3; 3]]) -> Mesh {
     m
 }
 
-fn focus() -> FocusScene {
-    FocusScene::whole(scene().bounds().unwrap())
+fn focus() -> SceneBounds {
+    SceneBounds::whole(scene().bounds().unwrap())
 }
 
 /// Renders `tris` on the GPU and the CPU and returns (differing texels, total).

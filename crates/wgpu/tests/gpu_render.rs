@@ -15,7 +15,7 @@ use shadowmap_frustum::{
 };
 use shadowmap_paraboloid::{MapOptions, ParaboloidMap, Side, subdivide_triangles};
 use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
-use shadowmap_warp::{FocusScene, UniformOptions, XpsmOptions, uniform_focused, xpsm};
+use shadowmap_warp::{SceneBounds, UniformOptions, XpsmOptions, uniform_focused, xpsm};
 use shadowmap_wgpu::GpuContext;
 use shadowmap_wgpu::depth::{DepthBias, subdivide_for_rtw};
 use shadowmap_wgpu::render::{
@@ -199,7 +199,7 @@ fn matrix_and_cascade_masks_match_the_cpu_reference() {
     };
     let mut renderer = HeadlessRenderer::new();
     let tris = scene();
-    let focus = FocusScene::whole(bounds());
+    let focus = SceneBounds::whole(bounds());
 
     let uniform = uniform_focused(&camera(), LIGHT, &focus, &UniformOptions::default()).unwrap();
     let gpu = render(
@@ -311,7 +311,7 @@ fn paraboloid_and_rtw_masks_match_the_cpu_reference() {
     let base = uniform_focused(
         &camera(),
         LIGHT,
-        &FocusScene::whole(bounds()),
+        &SceneBounds::whole(bounds()),
         &UniformOptions::default(),
     )
     .unwrap();
@@ -354,7 +354,7 @@ fn every_filter_renders_and_png_round_trips() {
     let uniform = uniform_focused(
         &camera(),
         LIGHT,
-        &FocusScene::whole(bounds()),
+        &SceneBounds::whole(bounds()),
         &UniformOptions::default(),
     )
     .unwrap();
@@ -414,7 +414,7 @@ fn bad_render_input_is_a_typed_error() {
     let uniform = uniform_focused(
         &camera(),
         LIGHT,
-        &FocusScene::whole(bounds()),
+        &SceneBounds::whole(bounds()),
         &UniformOptions::default(),
     )
     .unwrap();
