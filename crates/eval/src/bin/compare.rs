@@ -37,15 +37,14 @@ struct Args {
     /// the plots (replaced as a whole; render_scene's rendered/ is kept).
     #[arg(long, default_value = "target/shadowmap-report")]
     out: PathBuf,
-    /// Small images, short paths, small budget: a run of a few seconds, for tests
-    /// and CI.
+    /// Small images, short paths, small budget (about 3 s; for tests and CI).
     #[arg(long)]
     quick: bool,
     /// Seed of the procedural scenes.
     #[arg(long, default_value_t = DEFAULT_SEED)]
     seed: u64,
     /// Also evaluate a mesh (.obj, .gltf, .glb) with an automatic camera and light
-    /// (configuration mesh_<file name>).
+    /// (a configuration named mesh_NAME after the file NAME.obj).
     #[arg(long)]
     mesh: Option<PathBuf>,
     /// Robustness sweep: this many random camera/light configurations per scene,

@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 use crate::technique::TechniqueKind;
 
 use super::image::heat_colour;
-use super::sweep::{SweepSummary, TIE_BAND};
+use super::sweep::{SweepSummary, TIE_BAND, baseline_of};
 use super::text::{best_technique, short};
 use super::{ConfigSummary, Report, Row};
 
@@ -42,7 +42,7 @@ padding:0 1em;color:#222;line-height:1.4}\
 h2{border-top:2px solid #ccc;padding-top:.6em;margin-top:2em}\
 table{border-collapse:collapse;font-size:.9em;margin:.5em 0}\
 th,td{border:1px solid #ccc;padding:.2em .5em;text-align:right}\
-td:first-child,th:first-child{text-align:left}\
+td:first-child,th:first-child,.t{text-align:left}\
 th{background:#f0f0f0;cursor:pointer;user-select:none}\
 th.asc::after{content:' \\25B2'}th.desc::after{content:' \\25BC'}\
 tr.best td{background:#eef7ee;font-weight:600}\
@@ -102,8 +102,9 @@ fn header(s: &mut String, report: &Report) {
          repository.</p>",
         st.width, st.height, st.texel_budget, st.path_frames, report.seed
     );
+    overview(s, report);
     s.push_str(
-        "<dl class=\"defs\">\n\
+        "<h2 id=\"definitions\">What the columns mean</h2>\n<dl class=\"defs\">\n\
          <dt>m — aliasing error</dt><dd>the largest extent of one shadow-map texel on \
          the screen, in pixels, at each visible, front-lit pixel: 1 is pixel-matched, \
          above 1 the map undersamples (jagged shadow edges). Lower is better.</dd>\n\
@@ -125,17 +126,58 @@ fn header(s: &mut String, report: &Report) {
          texels). The rtw_oracle row is RTW fed the exact density m⊥ requires.</dd>\n\
          </dl>\n",
     );
-    s.push_str("<p>Configurations: ");
-    let links: Vec<String> = report
-        .configs
-        .iter()
-        .map(|c| format!("<a href=\"#{0}\">{0}</a>", esc(&c.name)))
-        .collect();
-    s.push_str(&links.join(", "));
+}
+
+/// The best technique of every configuration against its baseline, one table.
+fn overview(s: &mut String, report: &Report) {
+    s.push_str(
+        "<h2 id=\"overview\">At a glance</h2>\n<p>The technique with the lowest p95 of the \
+         aliasing error m per configuration (the RTW oracle, a bound, left out), against \
+         the light's baseline; click a configuration for its tables and pictures, a \
+         column header to sort. Then: <a href=\"#definitions\">what the columns mean</a>",
+    );
     if report.sweep.is_some() {
-        s.push_str(", <a href=\"#sweep\">robustness sweep</a>");
+        s.push_str(", <a href=\"#sweep\">the robustness sweep</a>");
     }
-    s.push_str(", <a href=\"#notes\">notes</a>.</p>\n");
+    s.push_str(
+        ", <a href=\"#notes\">notes on surprising results</a>.</p>\n\
+         <table class=\"sortable\">\n<thead><tr><th>configuration</th><th class=\"t\">light</th>\
+         <th class=\"t\">best technique</th><th>its p95 m</th><th class=\"t\">baseline</th><th>baseline p95 m</th>\
+         <th>baseline / best</th></tr></thead>\n<tbody>\n",
+    );
+    for c in &report.configs {
+        let name = esc(&c.name);
+        let rows: Vec<&Row> = report.rows.iter().filter(|r| r.config == c.name).collect();
+        let kinds: Vec<TechniqueKind> = rows.iter().map(|r| r.technique).collect();
+        let baseline = baseline_of(&kinds);
+        let base_p95 = rows
+            .iter()
+            .find(|r| Some(r.technique) == baseline)
+            .and_then(|r| r.outcome.as_ref().ok()?.aliasing.m)
+            .map(|m| m.p95);
+        let best = best_technique(report, &c.name);
+        let num = |v: Option<f64>| {
+            let v = v.filter(|v| v.is_finite());
+            format!(
+                "<td data-v=\"{}\">{}</td>",
+                v.map(|v| format!("{v:e}")).unwrap_or_default(),
+                short(v)
+            )
+        };
+        let _ = writeln!(
+            s,
+            "<tr><td data-v=\"{0}\"><a href=\"#{0}\">{0}</a></td><td class=\"t\" data-v=\"{1}\">{1}</td>\
+             <td class=\"t\" data-v=\"{2}\"><strong>{2}</strong></td>{3}<td class=\"t\" data-v=\"{4}\">{4}</td>{5}{6}</tr>",
+            name,
+            c.light_kind,
+            best.map_or("–", |b| b.0.name()),
+            num(best.map(|b| b.1)),
+            baseline.map_or("–", TechniqueKind::name),
+            num(base_p95),
+            num(base_p95.zip(best).map(|(b, (_, p))| b / p)),
+        );
+    }
+    s.push_str("</tbody>\n</table>\n");
 }
 
 /// Table columns: header, and per measured row the sort value and the shown text.
@@ -282,6 +324,13 @@ fn config_section(s: &mut String, report: &Report, c: &ConfigSummary) {
     let rows: Vec<&Row> = report.rows.iter().filter(|r| r.config == c.name).collect();
     table(s, &rows, best.map(|b| b.0));
     let measured: Vec<&Row> = rows.iter().copied().filter(|r| r.outcome.is_ok()).collect();
+    pictures(s, c, &measured);
+}
+
+/// The depth plot, the heatmaps and the masks of one configuration's `measured`
+/// techniques; closes its section.
+fn pictures(s: &mut String, c: &ConfigSummary, measured: &[&Row]) {
+    let name = esc(&c.name);
     let file = |prefix: &str, t: TechniqueKind| format!("{prefix}_{}_{}.png", c.name, t.name());
     let _ = writeln!(
         s,
@@ -303,7 +352,7 @@ fn config_section(s: &mut String, report: &Report, c: &ConfigSummary) {
         swatch([128, 128, 128]),
         swatch(heat_colour(f64::NAN)),
     );
-    for r in &measured {
+    for r in measured {
         let t = r.technique.name();
         let _ = writeln!(
             s,
@@ -326,7 +375,7 @@ fn config_section(s: &mut String, report: &Report, c: &ConfigSummary) {
         swatch([220, 40, 40]),
         swatch([40, 90, 230]),
     );
-    for r in &measured {
+    for r in measured {
         let t = r.technique.name();
         let _ = writeln!(
             s,
@@ -416,11 +465,14 @@ fn rendered_section(s: &mut String, rendered: &[String]) {
 fn notes(s: &mut String) {
     s.push_str(
         "<section id=\"notes\">\n<h2>Notes on results that look like bugs</h2>\n<ul>\n\
-         <li><strong>lispsm and xpsm give the same numbers</strong> where the light is \
-         perpendicular to the view direction (<code>overhead</code>): both warp along the \
-         view direction projected into light space with the same optimal warp strength \
-         there, so they build the same map; they part where the light tilts toward or \
-         away from the viewer.</li>\n\
+         <li><strong>lispsm and xpsm are within a few percent of each other</strong> where \
+         the light is perpendicular to the view direction (<code>overhead</code>): both \
+         warp along the view direction projected into light space, with nearly the same \
+         strength there; they part where the light tilts toward or away from the \
+         viewer (<code>behind</code>, <code>grazing</code>).</li>\n\
+         <li><strong>auto equals another row</strong>: it picks one of the matrix \
+         techniques or cascades per frame, so its numbers are those of its pick (its \
+         line in the depth plots is dashed so that both stay visible).</li>\n\
          <li><strong>rtw_oracle can be worse than rtw</strong>: the oracle is fed the \
          exact density of the perspective-only error m⊥ for a separable warp, so it is a \
          bound on S⊥ and S_sep, not on the true-normal m, which adds the projective \

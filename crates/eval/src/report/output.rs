@@ -233,6 +233,34 @@ mod tests {
     use super::*;
 
     #[test]
+    fn rendered_images_are_kept_and_nothing_else_is_taken_for_them() {
+        let dir = std::env::temp_dir().join(format!("shadowmap-rendered-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let target = dir.join("report");
+        std::fs::create_dir_all(target.join(RENDERED)).unwrap();
+        std::fs::write(target.join("report.md"), "old").unwrap();
+        std::fs::write(target.join("rendered/lispsm.png"), "png").unwrap();
+        assert!(check_target(&target).is_ok());
+        assert_eq!(rendered_images(&target), ["rendered/lispsm.png"]);
+        let staging = Staging::create(&target).unwrap();
+        std::fs::write(staging.path().join("report.md"), "new").unwrap();
+        staging.commit().unwrap();
+        assert_eq!(
+            std::fs::read_to_string(target.join("report.md")).unwrap(),
+            "new"
+        );
+        assert_eq!(
+            rendered_images(&target),
+            ["rendered/lispsm.png"],
+            "carried over"
+        );
+        // A rendered/ holding anything but PNG files is not the backend's.
+        std::fs::write(target.join("rendered/notes.txt"), "mine").unwrap();
+        assert!(check_target(&target).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
     fn report_files_are_recognised() {
         for name in [
             "report.md",

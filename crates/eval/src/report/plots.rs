@@ -351,25 +351,22 @@ pub(super) fn sweep_plot_svg(summary: &SweepSummary) -> Result<String, String> {
             .draw()
             .map_err(err)?;
         let parts = sweep_parts();
-        for (row, t) in summary.tallies.iter().enumerate() {
+        let colours: [RGBColor; 4] = parts.each_ref().map(|p| p.1);
+        let bars = summary.tallies.iter().enumerate().flat_map(|(row, t)| {
             let y = (rows - 1 - row) as f64;
-            let mut start = 0.0;
-            for (count, (_, colour)) in [t.wins, t.ties, t.losses, t.unmeasured]
-                .into_iter()
-                .zip(&parts)
-            {
-                let end = start + count as f64;
-                if count > 0 {
-                    chart
-                        .draw_series([Rectangle::new(
-                            [(start, y - 0.35), (end, y + 0.35)],
-                            colour.filled(),
-                        )])
-                        .map_err(err)?;
-                }
-                start = end;
-            }
-        }
+            let counts = [t.wins, t.ties, t.losses, t.unmeasured];
+            (0..counts.len())
+                .filter(move |&k| counts[k] > 0)
+                .map(move |k| {
+                    let start: usize = counts[..k].iter().sum();
+                    let end = start + counts[k];
+                    Rectangle::new(
+                        [(start as f64, y - 0.35), (end as f64, y + 0.35)],
+                        colours[k].filled(),
+                    )
+                })
+        });
+        chart.draw_series(bars).map_err(err)?;
         let legend: Vec<(String, RGBColor, Mark)> = parts
             .iter()
             .map(|(label, colour)| (label.clone(), *colour, Mark::Box))

@@ -245,7 +245,9 @@ fn markdown_header(report: &Report) -> String {
         s,
         "Image {}×{} pixels; texel budget {} texels per technique (all layers); camera \
          paths of {} frames; scene seed {}. Produced by \
-         `cargo run --release -p shadowmap-eval --bin compare`.\n",
+         `cargo run --release -p shadowmap-eval --bin compare`. `index.html` beside \
+         this file shows the same report with plots, labelled pictures and sortable \
+         tables.\n",
         st.width, st.height, st.texel_budget, st.path_frames, report.seed
     );
     s.push_str(
