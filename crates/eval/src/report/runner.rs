@@ -186,7 +186,7 @@ fn progress_bar(configs: &[Configuration], show: bool, label: &str) -> indicatif
         indicatif::ProgressDrawTarget::stderr(),
     );
     if let Ok(style) = indicatif::ProgressStyle::with_template(
-        "{prefix} [{bar:30}] {pos}/{len} techniques, {elapsed} elapsed, about {eta} left: {wide_msg}",
+        "{prefix} [{bar:20}] {pos}/{len} techniques, ETA {eta}: {wide_msg}",
     ) {
         bar.set_style(style.progress_chars("=> "));
     }
@@ -234,7 +234,11 @@ fn evaluate_all(
     } else {
         "sweep case"
     };
-    let bar = progress_bar(configs, options.progress, label);
+    let bar = progress_bar(
+        configs,
+        options.progress,
+        if pictures { "compare" } else { "sweep" },
+    );
     let lines = ProgressLines {
         show: options.progress_lines,
         label,
