@@ -134,6 +134,28 @@ fn tick(v: f64) -> String {
 
 const LABEL_SIZE: u32 = 15;
 
+/// Tick values for a logarithmic axis over `lo..hi`: 1, 2 and 5 times the powers
+/// of ten inside the range, or every integer multiple where that gives fewer
+/// than four ticks.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+        return Vec::new();
+    }
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let ticks = |mantissas: &[f64]| -> Vec<f64> {
+        (first..=last)
+            .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let coarse = ticks(&[1.0, 2.0, 5.0]);
+    if coarse.len() >= 4 {
+        coarse
+    } else {
+        ticks(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+    }
+}
+
 /// The aliasing error against view depth as an SVG document.
 pub(super) fn depth_plot_svg(plot: &DepthPlot<'_>) -> Result<String, String> {
     let mut svg = String::new();
@@ -197,7 +219,10 @@ fn draw_depth_chart(area: &DrawingArea<SVGBackend<'_>, Shift>, plot: &DepthPlot<
         .margin(12)
         .x_label_area_size(52)
         .y_label_area_size(72)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+        .build_cartesian_2d(
+            (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+            (y0..y1).log_scale().with_key_points(log_ticks(y0, y1)),
+        )
         .map_err(err)?;
     chart
         .configure_mesh()
@@ -477,6 +502,15 @@ mod tests {
             std::iter::repeat_n((2.0, 1.0), 10),
         );
         assert!(p.points.is_empty(), "no valid depth range");
+    }
+
+    #[test]
+    fn log_ticks_cover_the_range() {
+        assert_eq!(log_ticks(3.0, 300.0), [5.0, 10.0, 20.0, 50.0, 100.0, 200.0]);
+        // A short range gets every integer multiple.
+        assert_eq!(log_ticks(2.5, 9.5), [3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+        assert!(log_ticks(0.0, 1.0).is_empty());
+        assert!(log_ticks(5.0, 1.0).is_empty());
     }
 
     #[test]
