@@ -207,46 +207,24 @@ fn json(adapter: &str, profiler: &GpuProfiler, rows: &[Row]) -> String {
     )
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let as_json = args.iter().any(|a| a == "--json");
-    let frames = args
-        .iter()
-        .position(|a| a == "--frames")
-        .and_then(|i| args.get(i + 1))
-        .map_or(Ok(5), |n| n.parse::<usize>())?
-        .max(1);
-    let ctx = GpuContext::new_headless_with_features(GpuProfiler::FEATURES)?;
-    let mut profiler = GpuProfiler::new(&ctx, 8);
-    let scene = Scene::city_block(1);
-    let triangles: Vec<[Vec3; 3]> = scene
-        .mesh
-        .triangles()
-        .map(|t| t.map(DVec3::as_vec3))
-        .collect();
-    let focus = SceneBounds::whole(scene.bounds().ok_or("empty scene")?);
-    let camera = Camera::look_at(
-        Vec3::new(10.0, 18.0, 120.0),
-        Vec3::new(0.0, 4.0, 0.0),
-        Vec3::Y,
-        Projection::perspective(60f32.to_radians(), WIDTH as f32 / HEIGHT as f32, 1.0, 500.0),
-    )?;
+/// Fits and measures every technique, in the order of the table.
+fn measure_all(
+    frame: &Frame<'_>,
+    profiler: &mut GpuProfiler,
+    focus: &SceneBounds,
+    scene: &Scene,
+) -> Result<Vec<Row>, Box<dyn std::error::Error>> {
+    let camera = frame.camera;
     let light = Vec3::new(0.45, -0.8, -0.35);
-    let frame = Frame {
-        ctx: &ctx,
-        triangles: &triangles,
-        camera: &camera,
-        frames,
-    };
     let mut renderer = HeadlessRenderer::new();
     let mut rows = Vec::new();
     let mut run = |name, resolution, fit: Instant, t: &ShadowTechnique<'_>| {
         let fit_ms = ms_since(fit);
-        frame.measure(&mut renderer, &mut profiler, (name, resolution, fit_ms), t)
+        frame.measure(&mut renderer, profiler, (name, resolution, fit_ms), t)
     };
 
     let t = Instant::now();
-    let uniform = uniform_focused(&camera, light, &focus, &UniformOptions::default())?;
+    let uniform = uniform_focused(camera, light, focus, &UniformOptions::default())?;
     rows.push(run(
         "uniform",
         BUDGET,
@@ -259,7 +237,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let options = CascadeOptions::default()
         .with_resolution(BUDGET / 2)
         .with_scene(scene.scene_bounds());
-    let set = CascadeSet::fit(&camera, light, &splits, &options)?;
+    let set = CascadeSet::fit(camera, light, &splits, &options)?;
     rows.push(run(
         "cascades_4",
         BUDGET / 2,
@@ -267,7 +245,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &ShadowTechnique::Cascades(&set),
     )?);
     let t = Instant::now();
-    let l = lispsm(&camera, light, &focus, &LispsmOptions::default())?;
+    let l = lispsm(camera, light, focus, &LispsmOptions::default())?;
     rows.push(run(
         "lispsm",
         BUDGET,
@@ -275,10 +253,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &ShadowTechnique::Matrix(&l.transform),
     )?);
     let t = Instant::now();
-    let x = xpsm(&camera, light, &focus, &XpsmOptions::default())?;
+    let x = xpsm(camera, light, focus, &XpsmOptions::default())?;
     rows.push(run("xpsm", BUDGET, t, &ShadowTechnique::Xpsm(&x))?);
     let t = Instant::now();
-    let tr = tsm(&camera, light, &focus, &TsmOptions::default())?;
+    let tr = tsm(camera, light, focus, &TsmOptions::default())?;
     rows.push(run(
         "tsm",
         BUDGET,
@@ -287,9 +265,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?);
     let t = Instant::now();
     let w = warped_cascades(
-        &camera,
+        camera,
         light,
-        &focus,
+        focus,
         &splits,
         &[0.0; 4],
         &LispsmOptions::default(),
@@ -322,6 +300,40 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     rows.push(run("dpsm", 1448, t, &ShadowTechnique::Paraboloid(&map))?);
 
+    Ok(rows)
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let as_json = args.iter().any(|a| a == "--json");
+    let frames = args
+        .iter()
+        .position(|a| a == "--frames")
+        .and_then(|i| args.get(i + 1))
+        .map_or(Ok(5), |n| n.parse::<usize>())?
+        .max(1);
+    let ctx = GpuContext::new_headless_with_features(GpuProfiler::FEATURES)?;
+    let mut profiler = GpuProfiler::new(&ctx, 8);
+    let scene = Scene::city_block(1);
+    let triangles: Vec<[Vec3; 3]> = scene
+        .mesh
+        .triangles()
+        .map(|t| t.map(DVec3::as_vec3))
+        .collect();
+    let focus = SceneBounds::whole(scene.bounds().ok_or("empty scene")?);
+    let camera = Camera::look_at(
+        Vec3::new(10.0, 18.0, 120.0),
+        Vec3::new(0.0, 4.0, 0.0),
+        Vec3::Y,
+        Projection::perspective(60f32.to_radians(), WIDTH as f32 / HEIGHT as f32, 1.0, 500.0),
+    )?;
+    let frame = Frame {
+        ctx: &ctx,
+        triangles: &triangles,
+        camera: &camera,
+        frames,
+    };
+    let rows = measure_all(&frame, &mut profiler, &focus, &scene)?;
     let out = if as_json {
         json(&ctx.describe(), &profiler, &rows)
     } else {

@@ -82,7 +82,7 @@ impl ShadowMask {
     }
 }
 
-/// What [`HeadlessRenderer::render`] returns.
+/// What [`HeadlessRenderer::render`](super::HeadlessRenderer::render) returns.
 #[derive(Clone, Debug)]
 pub struct RenderedFrame {
     /// The shaded image.

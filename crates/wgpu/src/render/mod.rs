@@ -9,7 +9,7 @@
 //! (`shadowmap_eval`'s `DepthMap::is_lit`), whatever the filter.
 //!
 //! The renderer is for tests, reports and examples: it uploads the geometry every
-//! frame and waits for the GPU. An engine would keep the [`ShadowDepthPass`] and the
+//! frame and waits for the GPU. An engine would keep the [`ShadowDepthPass`](crate::depth::ShadowDepthPass) and the
 //! lookup shaders and drop the rest.
 //!
 //! ```no_run
@@ -209,15 +209,7 @@ impl HeadlessRenderer {
         };
         let camera_reversed = view.camera.reversed_z;
         let key = (technique.lookup(), options.filter.key(), camera_reversed);
-        let pipeline = match self.scene.entry(key) {
-            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(v) => v.insert(create_scene_pipeline(
-                &ctx.device,
-                key.0,
-                options.filter,
-                camera_reversed,
-            )?),
-        };
+        let pipeline = self.scene_pipeline(&ctx.device, key, options.filter)?;
         let targets = SceneTargets::new(&ctx.device, options.width, options.height);
         let job = (&scene_mesh, &targets, camera_reversed);
         timed(&mut profiler, &mut encoder, "scene", |e| {
@@ -228,6 +220,24 @@ impl HeadlessRenderer {
         }
         ctx.queue.submit([encoder.finish()]);
         targets.read(ctx)
+    }
+}
+
+impl HeadlessRenderer {
+    /// The cached scene pipeline of (lookup, filter key, camera reversed-Z), created
+    /// on first use.
+    fn scene_pipeline(
+        &mut self,
+        device: &wgpu::Device,
+        key: (Lookup, u8, bool),
+        filter: ShadowFilter,
+    ) -> Result<&ScenePipeline, BackendError> {
+        Ok(match self.scene.entry(key) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(v) => {
+                v.insert(create_scene_pipeline(device, key.0, filter, key.2)?)
+            }
+        })
     }
 }
 

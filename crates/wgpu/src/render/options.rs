@@ -65,7 +65,7 @@ impl ShadowFilter {
     }
 }
 
-/// Knobs of [`HeadlessRenderer::render`].
+/// Knobs of [`HeadlessRenderer::render`](super::HeadlessRenderer::render).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct RenderOptions {
