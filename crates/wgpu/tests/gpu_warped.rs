@@ -2,7 +2,8 @@
 //! renderer's shadow mask equals the CPU reference (the reference rasterizer's depth
 //! map of the same per-cascade perspective matrices, looked up by view depth at the
 //! point each pixel's primary ray sees) on at least 99.9% of pixels, with standard
-//! and reversed depth; a cascade set without a fitted cascade is a typed error.
+//! and reversed depth; a cascade set without a fitted cascade is a typed error; a
+//! profiled render draws the same frame and times its passes.
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap_eval::bvh::Bvh;
@@ -14,6 +15,7 @@ use shadowmap_frustum::{
 };
 use shadowmap_warp::{LispsmOptions, SceneBounds, WarpedCascades, warped_cascades};
 use shadowmap_wgpu::depth::DepthBias;
+use shadowmap_wgpu::profile::GpuProfiler;
 use shadowmap_wgpu::render::{
     HeadlessRenderer, MaskValue, RenderOptions, ShadowBias, ShadowFilter, ShadowTechnique,
 };
@@ -272,4 +274,49 @@ fn cascade_sets_without_a_fitted_cascade_are_typed_errors() {
     // The fitted set renders.
     let set = fit(false);
     assert!(render(&mut renderer, &ShadowTechnique::WarpedCascades(&set)).is_ok());
+}
+
+#[test]
+fn a_profiled_render_times_each_pass_and_renders_the_same_frame() {
+    let Some(plain_ctx) = shadowmap_wgpu::context::test_context(
+        "a_profiled_render_times_each_pass_and_renders_the_same_frame",
+    ) else {
+        return;
+    };
+    drop(plain_ctx);
+    let ctx = GpuContext::new_headless_with_features(GpuProfiler::FEATURES).expect("device");
+    let mut profiler = GpuProfiler::new(&ctx, 4);
+    let set = fit(false);
+    let technique = ShadowTechnique::WarpedCascades(&set);
+    let mut renderer = HeadlessRenderer::new();
+    let options = options().with_filter(ShadowFilter::Vsm { blur_radius: 2 });
+    let render = |renderer: &mut HeadlessRenderer, profiler: Option<&mut GpuProfiler>| {
+        match profiler {
+            Some(p) => {
+                renderer.render_profiled(&ctx, &triangles(), &camera(), &technique, &options, p)
+            }
+            None => renderer.render(&ctx, &triangles(), &camera(), &technique, &options),
+        }
+        .expect("render")
+    };
+    let plain = render(&mut renderer, None);
+    let profiled = render(&mut renderer, Some(&mut profiler));
+    assert_eq!(plain.mask, profiled.mask, "profiling changes nothing drawn");
+    let passes = profiler.read(&ctx).expect("timestamps");
+    match profiler.unsupported() {
+        Some(why) => {
+            eprintln!("profiler inert: {why}");
+            assert!(passes.is_empty());
+        }
+        None => {
+            let labels: Vec<&str> = passes.iter().map(|p| p.label.as_str()).collect();
+            assert_eq!(labels, ["depth", "vsm", "scene"]);
+            for p in &passes {
+                eprintln!("{}: {:.3} ms", p.label, p.gpu_ms);
+                assert!(p.gpu_ms.is_finite() && p.gpu_ms >= 0.0, "{p:?}");
+            }
+            // A frame read twice gives nothing the second time.
+            assert!(profiler.read(&ctx).expect("timestamps").is_empty());
+        }
+    }
 }
