@@ -84,10 +84,18 @@ impl ConvexBody {
         };
         let n = body.planes.len();
         for i in 0..n {
+            let a = body.planes[i];
+            // `c × a` for every later plane `c`, shared by all triples that start at `a`.
+            let ca: ArrayVec<DVec3, MAX_BODY_PLANES> = body.planes[i + 1..]
+                .iter()
+                .map(|c| c.normal.cross(a.normal))
+                .collect();
             for j in i + 1..n {
+                let b = body.planes[j];
+                let ab = a.normal.cross(b.normal);
                 for k in j + 1..n {
-                    let (a, b, c) = (&body.planes[i], &body.planes[j], &body.planes[k]);
-                    let Some(p) = intersect3(a, b, c) else {
+                    let c = &body.planes[k];
+                    let Some(p) = intersect3(&a, &b, c, ca[k - i - 1], ab) else {
                         continue;
                     };
                     if body.planes.iter().all(|pl| pl.distance(p) >= -inside_tol) {
@@ -259,13 +267,15 @@ fn push_plane(planes: &mut ArrayVec<DPlane, MAX_BODY_PLANES>, p: DPlane) {
     }
 }
 
-/// Intersection point of three planes, `None` when (nearly) dependent.
-fn intersect3(a: &DPlane, b: &DPlane, c: &DPlane) -> Option<DVec3> {
+/// Intersection point of three planes, `None` when (nearly) dependent; `ca` and `ab`
+/// are the cross products `c × a` and `a × b` of their normals (shared between
+/// triples by the caller).
+fn intersect3(a: &DPlane, b: &DPlane, c: &DPlane, ca: DVec3, ab: DVec3) -> Option<DVec3> {
     let bc = b.normal.cross(c.normal);
     let det = a.normal.dot(bc);
     if det.abs() < 1e-12 {
         return None;
     }
-    let p = (bc * -a.d + c.normal.cross(a.normal) * -b.d + a.normal.cross(b.normal) * -c.d) / det;
+    let p = (bc * -a.d + ca * -b.d + ab * -c.d) / det;
     p.is_finite().then_some(p)
 }

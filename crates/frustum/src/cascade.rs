@@ -436,7 +436,7 @@ impl Fitter {
         } else {
             (near_dist, far_dist)
         };
-        let clip_from_light = crate::projection::orthographic(
+        let clip_from_world = crate::projection::orthographic_times_affine(
             xy_lo.x,
             xy_hi.x,
             xy_lo.y,
@@ -444,8 +444,9 @@ impl Fitter {
             near_dist,
             far_dist,
             self.options.reversed_z,
-        );
-        let clip_from_world = (clip_from_light * *light).as_mat4();
+            light,
+        )
+        .as_mat4();
         if !crate::is_invertible(&clip_from_world, reach.max(depth_scale) as f32) {
             return Err(FrustumError::DegenerateFrustum);
         }

@@ -149,15 +149,15 @@ pub fn is_invertible(m: &Mat4, world_scale: f32) -> bool {
             d.w_axis[r],
         )
     });
+    let norms = rows.map(glam::DVec4::length_squared);
+    if norms.contains(&0.0) {
+        return false;
+    }
     for i in 0..4 {
         for j in i + 1..4 {
-            let (a, b) = (rows[i].length_squared(), rows[j].length_squared());
-            if a == 0.0 || b == 0.0 {
-                return false;
-            }
             let dot = rows[i].dot(rows[j]);
             // sin² of the angle between the rows.
-            if 1.0 - dot * dot / (a * b) < 1e-12 {
+            if 1.0 - dot * dot / (norms[i] * norms[j]) < 1e-12 {
                 return false;
             }
         }
