@@ -675,14 +675,14 @@ pub(crate) fn bounding_sphere_search(corners: &[DVec3; 8]) -> (DVec3, f64) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::{bounding_sphere, bounding_sphere_search};
     use glam::DVec3;
     use proptest::prelude::*;
     use shadowmap_testgen::{arbitrary::Unstructured, camera, in_range, strategy};
 
     /// This crate's camera from the generators' (they link the library build).
-    fn local(c: &shadowmap_testgen::frustum::built::Camera) -> crate::Camera {
+    pub(crate) fn local(c: &shadowmap_testgen::frustum::built::Camera) -> crate::Camera {
         use crate::Projection as P;
         use shadowmap_testgen::frustum::built::Projection as Q;
         let projection = match c.projection {
