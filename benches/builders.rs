@@ -1,22 +1,24 @@
-//! Every per-frame builder timed in one run, beside the transcription of Bevy's
-//! per-frame directional cascade math (`cascades_vs_bevy` in `benches/cascades.rs`
-//! keeps the transcription; this file includes it): uniform focused, stable and tight
-//! 4-cascade fits, LiSPSM, XPSM, TSM, four warped cascades, the spot fit, the IPSM
-//! plan with the paper's and the exact cone, and RTW warp tables from a 1-D
-//! importance. Besides criterion's figures it prints one table: each builder's time
-//! per call (thread CPU time, median of batches) and its ratio to Bevy's 4 cascades.
+//! Every per-frame builder timed in one run, beside our transcription of Bevy's
+//! per-frame directional cascade math (`benches/support/bevy_like.rs`, shared with
+//! `cascades_vs_bevy`): uniform focused, stable and tight 4-cascade fits, LiSPSM,
+//! XPSM, TSM, four warped cascades, the spot fit, the IPSM plan with the paper's and
+//! the exact cone, RTW warp tables from a 1-D importance, and camera validation; the
+//! cascade fits and the four single-frustum warps also from a camera validated once
+//! per frame (`ValidCamera`). Besides criterion's figures it prints one table: each
+//! builder's time per call (thread CPU time, median of batches) and its ratio to
+//! Bevy's 4 cascades.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Quat, Vec3};
 use shadowmap::frustum::{
     Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light,
-    Projection, SceneBounds, SplitScheme, fit_spot,
+    Projection, SceneBounds, SplitScheme, ValidCamera, fit_spot,
 };
 use shadowmap::paraboloid::{ConeFit, IpsmOptions, IpsmPlan};
 use shadowmap::rtw::{ImportanceMap, WarpMaps, WarpOptions};
 use shadowmap::warp::{
-    LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm, uniform_focused,
-    warped_cascades, xpsm,
+    FocusBody, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
+    uniform_focused, warped_cascades, xpsm,
 };
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -40,6 +42,7 @@ struct Frame {
     point: Light,
     bounds: DepthBounds,
     importance: ImportanceMap,
+    valid: ValidCamera,
 }
 
 fn frame() -> Frame {
@@ -100,11 +103,12 @@ fn frame() -> Frame {
             max: 80.0,
         },
         importance,
+        valid: ValidCamera::new(&camera).unwrap(),
     }
 }
 
 /// The builders, by name.
-const NAMES: [&str; 13] = [
+const NAMES: [&str; 16] = [
     "bevy_cascades_4",
     "uniform_focused",
     "stable_cascades_4",
@@ -118,6 +122,9 @@ const NAMES: [&str; 13] = [
     "ipsm_plan_exact_cone",
     "rtw_tables_1d_1024",
     "camera_validate",
+    "stable_cascades_4_valid",
+    "tight_cascades_4_valid",
+    "focus_body_valid_all_4",
 ];
 
 /// Runs builder `which` once on `f` (`warps` is the RTW output buffer).
@@ -179,6 +186,19 @@ fn run(f: &Frame, warps: &mut WarpMaps, which: usize) {
         }
         12 => {
             black_box(cam.validate().is_ok());
+        }
+        13 => {
+            black_box(CascadeSet::fit_valid(&f.valid, light, &f.splits, &f.stable).unwrap());
+        }
+        14 => {
+            black_box(CascadeSet::fit_valid(&f.valid, light, &f.splits, &f.tight).unwrap());
+        }
+        15 => {
+            let body = FocusBody::new_valid(black_box(&f.valid), light, &f.scene).unwrap();
+            black_box(body.uniform(&UniformOptions::default()).unwrap());
+            black_box(body.lispsm(&LispsmOptions::default()).unwrap());
+            black_box(body.xpsm(&XpsmOptions::default()).unwrap());
+            black_box(body.tsm(&TsmOptions::default()).unwrap());
         }
         _ => unreachable!("no builder {which}"),
     }

@@ -414,7 +414,7 @@ fn intersect3(a: &DPlane, b: &DPlane, c: &DPlane, ca: DVec3, ab: DVec3) -> Optio
 mod tests {
     use super::ConvexBody;
     use crate::Aabb;
-    use crate::cascade::tests::local;
+    use crate::bounding_sphere::tests::local;
     use proptest::prelude::*;
     use shadowmap_testgen::frustum::body_case;
     use shadowmap_testgen::strategy;
