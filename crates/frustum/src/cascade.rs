@@ -210,7 +210,12 @@ impl CascadeSet {
         options: &CascadeOptions,
     ) -> Result<Self, FrustumError> {
         let fitter = Fitter::new(&camera.geometry, light_direction, options)?;
-        let mut cascades = ArrayVec::new();
+        let mut set = Self {
+            cascades: ArrayVec::new(),
+            splits: splits.clone(),
+            view_from_world: camera.geometry.view_from_world().as_mat4(),
+            resolution: options.resolution,
+        };
         for i in 0..splits.count() {
             let (near, far) = splits
                 .cascade_range(i)
@@ -223,14 +228,9 @@ impl CascadeSet {
                 }
                 other => other?,
             };
-            cascades.push(cascade);
+            set.cascades.push(cascade);
         }
-        Ok(Self {
-            cascades,
-            splits: splits.clone(),
-            view_from_world: fitter.camera.view_from_world().as_mat4(),
-            resolution: options.resolution,
-        })
+        Ok(set)
     }
 
     /// The cascade for a world point by its view depth, with the blend weight toward
@@ -279,15 +279,16 @@ pub fn fit_cascade(
     far_depth: f32,
     options: &CascadeOptions,
 ) -> Result<Cascade, FrustumError> {
-    let fitter = Fitter::new(&camera.geometry()?, light_direction, options)?;
+    let geometry = camera.geometry()?;
+    let fitter = Fitter::new(&geometry, light_direction, options)?;
     let (n, f) = fitter.camera.check_slice(near_depth, far_depth)?;
     fitter.fit(n as f32, f as f32)
 }
 
 /// Everything a cascade fit needs that does not depend on the slice, computed once
 /// per call of [`CascadeSet::fit`].
-struct Fitter {
-    camera: CameraGeometry,
+struct Fitter<'a> {
+    camera: &'a CameraGeometry,
     light_dir: DVec3,
     light_from_world: DMat4,
     /// `light_from_world` in `f32`, as stored in every cascade.
@@ -304,13 +305,12 @@ struct Fitter {
     scene: Option<SceneBounds>,
 }
 
-impl Fitter {
+impl<'a> Fitter<'a> {
     fn new(
-        camera: &CameraGeometry,
+        camera: &'a CameraGeometry,
         light_direction: Vec3,
         options: &CascadeOptions,
     ) -> Result<Self, FrustumError> {
-        let camera = *camera;
         let light_dir = unit(light_direction)?;
         if !(4..=MAX_RESOLUTION).contains(&options.resolution) {
             return Err(FrustumError::InvalidResolution);
@@ -335,16 +335,20 @@ impl Fitter {
             light_from_world,
             light_from_world32: light_from_world.as_mat4(),
             light_from_view,
-            light_ray_origin: camera
-                .ray_origin
-                .map(|o| light_from_view.transform_point3(o)),
-            light_ray_dir: camera.ray_dir.map(|d| light_from_view.transform_vector3(d)),
-            world_ray_origin: camera
-                .ray_origin
-                .map(|o| camera.world_from_view.transform_point3(o)),
-            world_ray_dir: camera
-                .ray_dir
-                .map(|d| camera.world_from_view.transform_vector3(d)),
+            light_ray_origin: core::array::from_fn(|i| {
+                light_from_view.transform_point3(camera.ray_origin[i])
+            }),
+            light_ray_dir: core::array::from_fn(|i| {
+                light_from_view.transform_vector3(camera.ray_dir[i])
+            }),
+            world_ray_origin: core::array::from_fn(|i| {
+                camera
+                    .world_from_view
+                    .transform_point3(camera.ray_origin[i])
+            }),
+            world_ray_dir: core::array::from_fn(|i| {
+                camera.world_from_view.transform_vector3(camera.ray_dir[i])
+            }),
             options: *options,
             scene,
         })
