@@ -272,7 +272,18 @@ impl Camera {
     /// # Errors
     /// As [`Camera::validate`].
     pub fn clip_from_world(&self) -> Result<Mat4, FrustumError> {
+        self.clip_from_geometry(&self.geometry()?)
+    }
+
+    /// The geometry with every check of [`Camera::validate`] passed (computed once).
+    pub(crate) fn checked_geometry(&self) -> Result<CameraGeometry, FrustumError> {
         let g = self.geometry()?;
+        self.clip_from_geometry(&g)?;
+        Ok(g)
+    }
+
+    /// [`Camera::clip_from_world`] from this camera's geometry.
+    fn clip_from_geometry(&self, g: &CameraGeometry) -> Result<Mat4, FrustumError> {
         let exact = self.projection_matrix().as_dmat4() * g.view_from_world();
         let m = exact.as_mat4();
         if resolves_depth_range(&m, &exact, &g.world_corners(g.near, g.far)) {

@@ -55,6 +55,18 @@ impl ValidCamera {
         })
     }
 
+    /// As [`ValidCamera::new`], with every check of [`Camera::validate`] (the `f32`
+    /// `clip_from_world` too), computing the geometry once.
+    ///
+    /// # Errors
+    /// The errors of [`Camera::validate`].
+    pub fn new_validated(camera: &Camera) -> Result<Self, FrustumError> {
+        Ok(Self {
+            camera: *camera,
+            geometry: camera.checked_geometry()?,
+        })
+    }
+
     /// The camera that was checked.
     #[must_use]
     pub const fn camera(&self) -> &Camera {
