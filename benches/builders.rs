@@ -6,7 +6,8 @@
 //! cascade fits and the four single-frustum warps also from a camera validated once
 //! per frame (`ValidCamera`). Besides criterion's figures it prints one table: each
 //! builder's time per call (thread CPU time, median of batches) and its ratio to
-//! Bevy's 4 cascades.
+//! Bevy's 4 cascades. `BUILDERS_ONLY` runs one builder for instruction counting (see
+//! `only`).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Quat, Vec3};
@@ -233,10 +234,35 @@ fn median_ns(mut f: impl FnMut()) -> f64 {
     samples[samples.len() / 2]
 }
 
+/// With `BUILDERS_ONLY=<name>` (and `BUILDERS_CALLS=<n>`, default 1), calls that one
+/// builder `n` times and times nothing: run under `valgrind --tool=callgrind` with two
+/// values of `n`, the difference of the instruction counts divided by the difference
+/// of `n` is the builder's instructions per call, repeatable on a loaded machine.
+fn only(f: &Frame, warps: &mut WarpMaps) -> bool {
+    let Ok(name) = std::env::var("BUILDERS_ONLY") else {
+        return false;
+    };
+    let calls: usize = std::env::var("BUILDERS_CALLS")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(1);
+    let which = NAMES
+        .iter()
+        .position(|n| *n == name)
+        .unwrap_or_else(|| panic!("BUILDERS_ONLY: no builder {name}; one of {NAMES:?}"));
+    for _ in 0..calls {
+        run(f, warps, which);
+    }
+    true
+}
+
 #[allow(clippy::print_stdout)] // The table is this bench's output.
 fn builders(c: &mut Criterion) {
     let f = frame();
     let mut warps = WarpMaps::new(1024, 1).unwrap();
+    if only(&f, &mut warps) {
+        return;
+    }
     let mut g = c.benchmark_group("builders");
     g.warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(1));
