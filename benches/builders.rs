@@ -5,9 +5,9 @@
 //! the exact cone, RTW warp tables from a 1-D importance, and camera validation; the
 //! cascade fits and the four single-frustum warps also from a camera validated once
 //! per frame (`ValidCamera`). Besides criterion's figures it prints one table: each
-//! builder's time per call (thread CPU time, median of batches) and its ratio to
-//! Bevy's 4 cascades. `BUILDERS_ONLY` runs one builder for instruction counting (see
-//! `only`).
+//! builder's time per call (the fastest of many short batches, see
+//! `support/timing.rs`) and its ratio to Bevy's 4 cascades. `BUILDERS_ONLY` runs one
+//! builder for instruction counting (see `only`).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Quat, Vec3};
@@ -22,11 +22,13 @@ use shadowmap::warp::{
     uniform_focused, warped_cascades, xpsm,
 };
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 #[allow(dead_code)] // Only the cascades bench reads every output field and constant.
 #[path = "support/bevy_like.rs"]
 mod bevy_like;
+#[path = "support/timing.rs"]
+mod timing;
 
 /// Everything the builders read: Bevy's default camera and cascade configuration, a
 /// ground plane with a block of casters, a spot and a point light.
@@ -205,35 +207,6 @@ fn run(f: &Frame, warps: &mut WarpMaps, which: usize) {
     }
 }
 
-/// CPU time this thread has run, in ns, where Linux reports it: on a shared machine the
-/// printed figures then count only this thread's own time, not the time it waited.
-fn thread_cpu_ns() -> Option<u64> {
-    let stat = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    stat.split_whitespace().next()?.parse().ok()
-}
-
-/// Median time per call of `f` over 31 batches, in ns (thread CPU time where
-/// available, wall-clock time otherwise).
-fn median_ns(mut f: impl FnMut()) -> f64 {
-    const BATCH: u32 = 2000;
-    let mut samples: Vec<f64> = (0..31)
-        .map(|_| {
-            let (cpu, start) = (thread_cpu_ns(), Instant::now());
-            for _ in 0..BATCH {
-                f();
-            }
-            let wall = start.elapsed().as_secs_f64() * 1e9;
-            let ns = match (cpu, thread_cpu_ns()) {
-                (Some(a), Some(b)) if b > a => (b - a) as f64,
-                _ => wall,
-            };
-            ns / f64::from(BATCH)
-        })
-        .collect();
-    samples.sort_by(f64::total_cmp);
-    samples[samples.len() / 2]
-}
-
 /// With `BUILDERS_ONLY=<name>` (and `BUILDERS_CALLS=<n>`, default 1), calls that one
 /// builder `n` times and times nothing: run under `valgrind --tool=callgrind` with two
 /// values of `n`, the difference of the instruction counts divided by the difference
@@ -271,13 +244,13 @@ fn builders(c: &mut Criterion) {
     }
     g.finish();
 
-    let bevy = median_ns(|| run(&f, &mut warps, 0));
-    println!("builders, one run (thread CPU time per call, median of 31 batches):");
+    let bevy = timing::min_ns(|| run(&f, &mut warps, 0));
+    println!("builders, one run (time per call, fastest of 201 batches):");
     for (i, name) in NAMES.iter().enumerate() {
         let t = if i == 0 {
             bevy
         } else {
-            median_ns(|| run(&f, &mut warps, i))
+            timing::min_ns(|| run(&f, &mut warps, i))
         };
         println!(
             "  {name:<22} {:>9.3} us  {:>7.2}x bevy_cascades_4",

@@ -12,10 +12,12 @@ use shadowmap::frustum::{
     SceneBounds, SplitScheme,
 };
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 #[path = "support/bevy_like.rs"]
 mod bevy_like;
+#[path = "support/timing.rs"]
+mod timing;
 
 fn cascades(c: &mut Criterion) {
     let camera = Camera::look_to(
@@ -65,36 +67,6 @@ fn cascades(c: &mut Criterion) {
         });
     });
     g.finish();
-}
-
-/// CPU time this thread has run, in ns, where Linux reports it: on a shared machine the
-/// printed ratios then count only this thread's own time, not the time it waited.
-fn thread_cpu_ns() -> Option<u64> {
-    let stat = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    stat.split_whitespace().next()?.parse().ok()
-}
-
-/// Median time per call of `f` over a few batches (for the printed ratios; criterion's
-/// own wall-clock figures are printed beside them). Thread CPU time where available,
-/// wall-clock time otherwise.
-fn median_ns<R>(mut f: impl FnMut() -> R) -> f64 {
-    const BATCH: u32 = 4000;
-    let mut samples: Vec<f64> = (0..31)
-        .map(|_| {
-            let (cpu, start) = (thread_cpu_ns(), Instant::now());
-            for _ in 0..BATCH {
-                black_box(f());
-            }
-            let wall = start.elapsed().as_secs_f64() * 1e9;
-            let ns = match (cpu, thread_cpu_ns()) {
-                (Some(a), Some(b)) if b > a => (b - a) as f64,
-                _ => wall,
-            };
-            ns / f64::from(BATCH)
-        })
-        .collect();
-    samples.sort_by(f64::total_cmp);
-    samples[samples.len() / 2]
 }
 
 #[allow(clippy::print_stdout)] // The ratios are this bench's output.
@@ -152,9 +124,9 @@ fn cascades_vs_bevy(c: &mut Criterion) {
     g.bench_function("tight_fit_4", |bch| bch.iter(|| ours(&tight)));
     g.finish();
 
-    let t_bevy = median_ns(bevy);
-    let t_stable = median_ns(|| ours(&stable));
-    let t_tight = median_ns(|| ours(&tight));
+    let t_bevy = timing::min_ns(bevy);
+    let t_stable = timing::min_ns(|| ours(&stable));
+    let t_tight = timing::min_ns(|| ours(&tight));
     println!(
         "cascades_vs_bevy: bevy {t_bevy:.0} ns, stable {t_stable:.0} ns ({:.2}x bevy), tight {t_tight:.0} ns ({:.2}x bevy)",
         t_stable / t_bevy,
