@@ -89,6 +89,11 @@ pub mod projection;
 mod split;
 mod spot;
 
+#[cfg(feature = "mint")]
+mod mint_impls;
+#[cfg(feature = "serde")]
+mod serde_impls;
+
 pub use body::{ConvexBody, MAX_BODY_VERTICES};
 pub use camera::{Camera, Projection};
 pub use cascade::{
@@ -110,3 +115,8 @@ pub use split::{CascadeBlend, CascadeSplits, MAX_CASCADES, SplitScheme};
 pub use spot::{SpotShadow, fit_spot};
 
 pub use glam;
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

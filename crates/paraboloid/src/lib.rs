@@ -210,6 +210,8 @@ mod error;
 mod map;
 mod orient;
 mod plan;
+#[cfg(feature = "serde")]
+mod serde_impls;
 mod subdivide;
 
 pub use cone::{Cone, ConeFit, MAX_CONE_DIRECTIONS, MIN_ZOOM, fit_minimal_cone, fit_paper_cone};
@@ -221,3 +223,8 @@ pub use subdivide::{
 };
 
 pub use shadowmap_frustum;
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -133,6 +133,8 @@ extern crate alloc;
 
 mod error;
 mod importance;
+#[cfg(feature = "serde")]
+mod serde_impls;
 mod subdivide;
 mod table;
 mod warp;
@@ -147,3 +149,8 @@ pub use table::{
     forward_warp, forward_warp_f64, inverse_warp, inverse_warp_f64, sample_table, sample_table_f64,
 };
 pub use warp::{MAX_BLUR_RADIUS, MIN_FLOOR, RtwShadow, WarpMaps, WarpOptions, gaussian_weights};
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

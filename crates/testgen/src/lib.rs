@@ -415,3 +415,8 @@ pub fn split_scheme_raw(u: &mut Unstructured<'_>, count: usize) -> GenResult<Spl
         },
     })
 }
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

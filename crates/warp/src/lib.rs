@@ -145,6 +145,8 @@ mod cascades;
 mod error;
 mod focus;
 mod lispsm;
+#[cfg(feature = "serde")]
+mod serde_impls;
 mod tsm;
 mod uniform;
 mod xpsm;
@@ -179,3 +181,8 @@ pub fn light_frame(camera: &Camera, light_direction: Vec3) -> Result<Mat4, WarpE
     let light = focus::light_unit(light_direction)?;
     Ok(focus::frame(light, view.forward, view.up).0.as_mat4())
 }
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
