@@ -3,16 +3,16 @@
 //! error, and the `mint` and `bytemuck` conversions keep every component.
 #![cfg(feature = "serde")]
 
-use core::fmt::Debug;
+use core::fmt::{Debug, Display};
 
 use glam::{Mat4, Vec3};
 use proptest::prelude::*;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use shadowmap_frustum::{
-    Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light,
-    PredictOptions, Projection, SceneBounds, ShadowMapping, SplitScheme, TechniqueSelector,
-    fit_spot, predict_error,
+    Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, FrustumError,
+    Light, PredictOptions, Projection, SceneBounds, ShadowMapping, Sphere, SplitScheme,
+    TechniqueSelector, fit_spot, predict_error,
 };
 use shadowmap_testgen::{
     GenResult, aabb, arbitrary::Unstructured, camera, frustum as cases, in_range, light_direction,
@@ -38,6 +38,17 @@ fn all_finite(value: &impl Debug) -> bool {
 fn rejects<T: DeserializeOwned + Debug>(json: &str) {
     let result = serde_json::from_str::<T>(json);
     assert!(result.is_err(), "{json} gave {result:?}");
+}
+
+/// Deserializing `json` as `T` fails with the message of the typed error `expected`.
+fn rejects_with<T: DeserializeOwned + Debug>(json: &str, expected: impl Display) {
+    match serde_json::from_str::<T>(json) {
+        Ok(value) => panic!("{json} gave {value:?}"),
+        Err(e) => assert!(
+            e.to_string().contains(&expected.to_string()),
+            "{json}: {e}, expected {expected}"
+        ),
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -75,6 +86,12 @@ proptest! {
         round_trip(&Light::Directional { direction: case.light });
         round_trip(&case.scene);
         round_trip(&case.scene.receivers);
+        let (centre, size) = (case.scene.receivers.center(), case.scene.receivers.size());
+        round_trip(&Sphere::new(centre, 0.5 * size.length()));
+        let lamp = Light::Point { position: centre, range: 1.0 + size.length() };
+        if lamp.validate().is_ok() {
+            round_trip(&lamp);
+        }
         if let Ok(frustum) = case.camera.frustum() {
             round_trip(&frustum);
             for plane in frustum.planes {
@@ -101,7 +118,10 @@ proptest! {
             return Ok(());
         };
         round_trip(&set);
-        let centre = case.scene.receivers.center();
+        for cascade in &set.cascades {
+            round_trip(cascade);
+            round_trip(&cascade.transform);
+        }
         if let Some(blend) = set.select_by_depth(centre) {
             round_trip(&blend);
             let transform = set.cascades[blend.index].transform;
@@ -207,34 +227,43 @@ fn bad_payloads_are_errors() {
     // pose do not.
     let good = r#"{"Perspective":{"fov_y":1.0,"aspect":1.0,"near":0.1,"far":10.0}}"#;
     serde_json::from_str::<Camera>(&camera(good)).unwrap();
-    rejects::<Camera>(&camera(
-        r#"{"Perspective":{"fov_y":0.0,"aspect":1.0,"near":0.1,"far":10.0}}"#,
-    ));
-    rejects::<Camera>(&camera(
-        r#"{"Perspective":{"fov_y":1.0,"aspect":1.0,"near":10.0,"far":0.1}}"#,
-    ));
+    let zero_fov = r#"{"Perspective":{"fov_y":0.0,"aspect":1.0,"near":0.1,"far":10.0}}"#;
+    rejects_with::<Camera>(&camera(zero_fov), FrustumError::InvalidFov);
+    let inverted = r#"{"Perspective":{"fov_y":1.0,"aspect":1.0,"near":10.0,"far":0.1}}"#;
+    rejects_with::<Camera>(&camera(inverted), "invalid depth range");
     let zero = serde_json::to_string(&Mat4::ZERO).unwrap();
     rejects::<Camera>(&format!(
         r#"{{"world_from_view":{zero},"projection":{good},"reversed_z":false}}"#
     ));
-    // Lights: a zero direction, a spot wider than a hemisphere, a non-positive range.
-    serde_json::from_str::<Light>(r#"{"Directional":{"direction":[0.0,-1.0,0.0]}}"#).unwrap();
-    rejects::<Light>(r#"{"Directional":{"direction":[0.0,0.0,0.0]}}"#);
-    rejects::<Light>(
-        r#"{"Spot":{"position":[0,0,0],"direction":[0,-1,0],"half_angle":2.0,"range":10}}"#,
-    );
-    rejects::<Light>(r#"{"Point":{"position":[0,0,0],"range":-1.0}}"#);
+    // Lights: a zero direction, a spot wider than a hemisphere, a negative range.
+    let sun = r#"{"Directional":{"direction":[0.0,-1.0,0.0]}}"#;
+    serde_json::from_str::<Light>(sun).unwrap();
+    let no_sun = r#"{"Directional":{"direction":[0.0,0.0,0.0]}}"#;
+    rejects_with::<Light>(no_sun, FrustumError::ZeroDirection);
+    let spot = |half_angle: f32| {
+        format!(
+            r#"{{"Spot":{{"position":[0,0,0],"direction":[0,-1,0],"half_angle":{half_angle},"range":10}}}}"#
+        )
+    };
+    serde_json::from_str::<Light>(&spot(1.0)).unwrap();
+    rejects_with::<Light>(&spot(2.0), FrustumError::InvalidLight);
+    let point = r#"{"Point":{"position":[0,0,0],"range":-1.0}}"#;
+    rejects_with::<Light>(point, FrustumError::InvalidLight);
     // Splits: decreasing or too few depths, a non-positive near, an overlap of 1,
     // more depths than cascades allowed.
     serde_json::from_str::<CascadeSplits>(r#"{"depths":[0.1,1.0,10.0],"overlap":0.2}"#).unwrap();
-    rejects::<CascadeSplits>(r#"{"depths":[0.1,10.0,1.0],"overlap":0.0}"#);
-    rejects::<CascadeSplits>(r#"{"depths":[0.1],"overlap":0.0}"#);
-    rejects::<CascadeSplits>(r#"{"depths":[0.0,1.0],"overlap":0.0}"#);
-    rejects::<CascadeSplits>(r#"{"depths":[0.1,1.0],"overlap":1.0}"#);
+    let decreasing = r#"{"depths":[0.1,10.0,1.0],"overlap":0.0}"#;
+    rejects_with::<CascadeSplits>(decreasing, FrustumError::InvalidCustomSplits);
+    rejects_with::<CascadeSplits>(r#"{"depths":[0.1],"overlap":0.0}"#, "at least two");
+    let at_zero = r#"{"depths":[0.0,1.0],"overlap":0.0}"#;
+    rejects_with::<CascadeSplits>(at_zero, "invalid depth range");
+    let full_band = r#"{"depths":[0.1,1.0],"overlap":1.0}"#;
+    rejects_with::<CascadeSplits>(full_band, FrustumError::InvalidSplitParameter);
     rejects::<CascadeSplits>(r#"{"depths":[1,2,3,4,5,6,7,8,9,10],"overlap":0.0}"#);
     // Prediction options out of range.
-    rejects::<PredictOptions>(r#"{"percentile":0.0}"#);
-    rejects::<PredictOptions>(r#"{"grid_columns":0}"#);
+    let bad_percentile = r#"{"percentile":0.0}"#;
+    rejects_with::<PredictOptions>(bad_percentile, FrustumError::InvalidResolution);
+    rejects_with::<PredictOptions>(r#"{"grid_columns":0}"#, FrustumError::InvalidResolution);
     // Wrong shapes.
     rejects::<Aabb>(r#"{"min":[0,0],"max":[1,1,1]}"#);
     rejects::<CascadeFit>(r#""Loose""#);
@@ -243,7 +272,7 @@ fn bad_payloads_are_errors() {
 #[cfg(feature = "mint")]
 #[test]
 fn mint_conversions_keep_every_component() {
-    use shadowmap_frustum::{Plane, Sphere};
+    use shadowmap_frustum::Plane;
     let aabb = Aabb::new(Vec3::new(-1.0, -2.0, -3.0), Vec3::new(4.0, 5.0, 6.0));
     let corners: [mint::Point3<f32>; 2] = aabb.into();
     assert_eq!((corners[1].x, corners[1].y, corners[1].z), (4.0, 5.0, 6.0));
@@ -265,7 +294,7 @@ fn mint_conversions_keep_every_component() {
 #[cfg(feature = "bytemuck")]
 #[test]
 fn plain_data_is_pod() {
-    use shadowmap_frustum::{Plane, Sphere};
+    use shadowmap_frustum::Plane;
     let planes = [Plane::new(Vec3::X, 1.0), Plane::new(Vec3::Y, -2.0)];
     let floats: &[f32] = bytemuck::cast_slice(&planes);
     assert_eq!(floats, &[1.0, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, -2.0]);

@@ -200,6 +200,11 @@
 //! `std` (default) or `libm` provide float math; with `libm` and without `std` the
 //! crate is `no_std` (it uses `alloc` only for [`subdivide_triangles`]). The plan
 //! allocates nothing.
+//!
+//! Optional data features, `no_std` compatible: `serde` (`Serialize` and
+//! `Deserialize` on the options and results; [`IpsmOptions`] and
+//! [`SubdivisionOptions`] deserialize through the builders' checks) and `mint`
+//! (glam's and `shadowmap-frustum`'s conversions).
 
 #![cfg_attr(not(feature = "std"), no_std)]
 

@@ -3,13 +3,13 @@
 //! error.
 #![cfg(feature = "serde")]
 
-use core::fmt::Debug;
+use core::fmt::{Debug, Display};
 
 use proptest::prelude::*;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use shadowmap_paraboloid::{
-    ConeFit, DualReason, IpsmOptions, IpsmPlan, MapOptions, ParaboloidMode, Side,
+    ConeFit, DualReason, IpsmOptions, IpsmPlan, MapOptions, ParaboloidError, ParaboloidMode, Side,
     SubdivisionOptions, fit_minimal_cone, fit_paper_cone,
 };
 use shadowmap_testgen::{paraboloid as cases, strategy};
@@ -26,6 +26,17 @@ fn round_trip<T: Serialize + DeserializeOwned + PartialEq + Debug>(value: &T) {
 fn rejects<T: DeserializeOwned + Debug>(json: &str) {
     let result = serde_json::from_str::<T>(json);
     assert!(result.is_err(), "{json} gave {result:?}");
+}
+
+/// Deserializing `json` as `T` fails with the message of the typed error `expected`.
+fn rejects_with<T: DeserializeOwned + Debug>(json: &str, expected: impl Display) {
+    match serde_json::from_str::<T>(json) {
+        Ok(value) => panic!("{json} gave {value:?}"),
+        Err(e) => assert!(
+            e.to_string().contains(&expected.to_string()),
+            "{json}: {e}, expected {expected}"
+        ),
+    }
 }
 
 proptest! {
@@ -109,12 +120,21 @@ fn missing_option_fields_take_their_defaults() {
 #[test]
 fn bad_payloads_are_errors() {
     // Out of the documented ranges (as the builders reject them).
-    rejects::<IpsmOptions>(r#"{"near": 0.0}"#);
-    rejects::<IpsmOptions>(r#"{"margin": -0.1}"#);
-    rejects::<IpsmOptions>(r#"{"max_single_half_angle": 2.0}"#);
-    rejects::<SubdivisionOptions>(r#"{"resolution": 0}"#);
-    rejects::<SubdivisionOptions>(r#"{"tolerance_texels": 0.0}"#);
-    rejects::<SubdivisionOptions>(r#"{"max_segments": 257}"#);
+    rejects_with::<IpsmOptions>(r#"{"near": 0.0}"#, ParaboloidError::InvalidOptions);
+    rejects_with::<IpsmOptions>(r#"{"margin": -0.1}"#, ParaboloidError::InvalidOptions);
+    rejects_with::<IpsmOptions>(
+        r#"{"max_single_half_angle": 2.0}"#,
+        ParaboloidError::InvalidOptions,
+    );
+    rejects_with::<SubdivisionOptions>(r#"{"resolution": 0}"#, ParaboloidError::InvalidSubdivision);
+    rejects_with::<SubdivisionOptions>(
+        r#"{"tolerance_texels": 0.0}"#,
+        ParaboloidError::InvalidSubdivision,
+    );
+    rejects_with::<SubdivisionOptions>(
+        r#"{"max_segments": 257}"#,
+        ParaboloidError::InvalidSubdivision,
+    );
     // Wrong shapes and names.
     rejects::<IpsmOptions>(r#"{"fit": "Approximate"}"#);
     rejects::<MapOptions>(r#"{"up_hint": [0.0, 1.0]}"#);

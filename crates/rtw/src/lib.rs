@@ -126,6 +126,12 @@
 //!
 //! `std` (default) or `libm` for float math; without `std` the crate is `no_std` and
 //! needs `alloc` (the importance map and warp buffers live on the heap, allocated once).
+//!
+//! Optional data features, `no_std` compatible: `serde` (`Serialize` and
+//! `Deserialize` on the options, samples and maps; an [`ImportanceMap`] or
+//! [`WarpMaps`] payload is validated, and warp tables must be the ones built from the
+//! payload's densities), `mint` (glam's and `shadowmap-frustum`'s conversions) and
+//! `bytemuck` (`Pod` on the `#[repr(C)]` [`EyeSample`], plus glam's).
 
 #![cfg_attr(not(feature = "std"), no_std)]
 

@@ -4,14 +4,14 @@
 //! error.
 #![cfg(feature = "serde")]
 
-use core::fmt::Debug;
+use core::fmt::{Debug, Display};
 
 use glam::Vec2;
 use proptest::prelude::*;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use shadowmap_rtw::{
-    ImportanceMap, ImportanceOptions, OracleAxis, RtwSubdivision, WarpMaps, WarpOptions,
+    ImportanceMap, ImportanceOptions, OracleAxis, RtwError, RtwSubdivision, WarpMaps, WarpOptions,
 };
 use shadowmap_testgen::{rtw as cases, strategy};
 
@@ -23,10 +23,15 @@ fn round_trip<T: Serialize + DeserializeOwned + PartialEq + Debug>(value: &T) {
     assert_eq!(&back, value, "through {json}");
 }
 
-/// Deserializing `json` as `T` fails.
-fn rejects<T: DeserializeOwned + Debug>(json: &str) {
-    let result = serde_json::from_str::<T>(json);
-    assert!(result.is_err(), "{json} gave {result:?}");
+/// Deserializing `json` as `T` fails with the message of the typed error `expected`.
+fn rejects_with<T: DeserializeOwned + Debug>(json: &str, expected: impl Display) {
+    match serde_json::from_str::<T>(json) {
+        Ok(value) => panic!("{json} gave {value:?}"),
+        Err(e) => assert!(
+            e.to_string().contains(&expected.to_string()),
+            "{json}: {e}, expected {expected}"
+        ),
+    }
 }
 
 /// `warps` through JSON: every table, density and maximum reads back bit for bit,
@@ -108,17 +113,23 @@ fn plain_options_round_trip() {
 #[test]
 fn bad_payloads_are_errors() {
     // Options out of range.
-    rejects::<WarpOptions>(r#"{"floor": 0.0}"#);
-    rejects::<WarpOptions>(r#"{"temporal": 1.0}"#);
-    rejects::<WarpOptions>(r#"{"blur_radius": 65}"#);
-    rejects::<ImportanceOptions>(r#"{"edge_weight": 0.5}"#);
+    rejects_with::<WarpOptions>(r#"{"floor": 0.0}"#, RtwError::InvalidOption);
+    rejects_with::<WarpOptions>(r#"{"temporal": 1.0}"#, RtwError::InvalidOption);
+    rejects_with::<WarpOptions>(r#"{"blur_radius": 65}"#, RtwError::InvalidOption);
+    rejects_with::<ImportanceOptions>(r#"{"edge_weight": 0.5}"#, RtwError::InvalidOption);
     // Importance maps: the size must be valid and match the cells, which must be
     // non-negative.
     serde_json::from_str::<ImportanceMap>(r#"{"width":2,"height":1,"cells":[0.0,3.0]}"#).unwrap();
-    rejects::<ImportanceMap>(r#"{"width":2,"height":1,"cells":[0.0]}"#);
-    rejects::<ImportanceMap>(r#"{"width":2,"height":1,"cells":[0.0,-1.0]}"#);
-    rejects::<ImportanceMap>(r#"{"width":0,"height":0,"cells":[]}"#);
-    rejects::<ImportanceMap>(r#"{"width":100000,"height":1,"cells":[]}"#);
+    let short = RtwError::SizeMismatch {
+        expected: 2,
+        got: 1,
+    };
+    rejects_with::<ImportanceMap>(r#"{"width":2,"height":1,"cells":[0.0]}"#, short);
+    let negative = r#"{"width":2,"height":1,"cells":[0.0,-1.0]}"#;
+    rejects_with::<ImportanceMap>(negative, RtwError::NegativeImportance);
+    rejects_with::<ImportanceMap>(r#"{"width":0,"height":0,"cells":[]}"#, RtwError::EmptyMap);
+    let huge = r#"{"width":100000,"height":1,"cells":[]}"#;
+    rejects_with::<ImportanceMap>(huge, RtwError::MapTooLarge);
 
     // Warp maps: a built value reads back; tampering with a table, a density or a
     // length does not.
@@ -134,27 +145,41 @@ fn bad_payloads_are_errors() {
         v[field][index] = serde_json::json!(value);
         v
     };
+    let mismatch = "warp tables do not match";
     let x1 = good["x"][1].as_f64().unwrap();
-    for bad in [
-        tampered("x", 1, x1 + 0.01),
-        tampered("density_x", 2, 0.5 * good["density_x"][2].as_f64().unwrap()),
-        tampered("density_y", 0, 0.0),
-        tampered("density_y", 0, 1.5),
-        tampered("col_max", 0, -1.0),
-    ] {
-        assert!(
-            serde_json::from_value::<WarpMaps>(bad.clone()).is_err(),
-            "{bad}"
-        );
-    }
+    let d2 = good["density_x"][2].as_f64().unwrap();
     let mut short = good.clone();
     short["row_max"].as_array_mut().unwrap().pop();
-    assert!(serde_json::from_value::<WarpMaps>(short).is_err());
-    let mut empty = good;
+    let mut empty = good.clone();
     for field in ["x", "col_max", "density_x"] {
         empty[field] = serde_json::json!([]);
     }
-    assert!(serde_json::from_value::<WarpMaps>(empty).is_err());
+    let out_of_range = RtwError::InvalidOption.to_string();
+    for (bad, expected) in [
+        (tampered("x", 1, x1 + 0.01), mismatch.to_string()),
+        (tampered("density_x", 2, 0.5 * d2), mismatch.to_string()),
+        (tampered("density_y", 0, 0.0), out_of_range.clone()),
+        (tampered("density_y", 0, 1.5), out_of_range),
+        (
+            tampered("col_max", 0, -1.0),
+            RtwError::NegativeImportance.to_string(),
+        ),
+        (
+            short,
+            RtwError::SizeMismatch {
+                expected: 4,
+                got: 3,
+            }
+            .to_string(),
+        ),
+        (empty, RtwError::EmptyMap.to_string()),
+    ] {
+        let e = serde_json::from_value::<WarpMaps>(bad.clone()).expect_err("tampered");
+        assert!(
+            e.to_string().contains(&expected),
+            "{bad}: {e}, expected {expected}"
+        );
+    }
 }
 
 #[cfg(feature = "bytemuck")]

@@ -138,6 +138,12 @@
 //!
 //! `std` (default) or `libm` provides float math; without `std` the crate is
 //! `no_std`. No builder allocates on the heap.
+//!
+//! Optional data features, all `no_std` compatible: `serde` (`Serialize` and
+//! `Deserialize` on the options and results; options deserialize through the
+//! builders' checks, and an unbounded value such as the default
+//! [`LispsmOptions::far_hint`] is written as none), `mint` and `bytemuck` (glam's and
+//! `shadowmap-frustum`'s).
 
 #![cfg_attr(not(feature = "std"), no_std)]
 

@@ -3,7 +3,7 @@
 //! error.
 #![cfg(feature = "serde")]
 
-use core::fmt::Debug;
+use core::fmt::{Debug, Display};
 
 use proptest::prelude::*;
 use serde::Serialize;
@@ -11,7 +11,7 @@ use serde::de::DeserializeOwned;
 use shadowmap_frustum::{CascadeSplits, SplitScheme};
 use shadowmap_testgen::{strategy, warp as cases};
 use shadowmap_warp::{
-    LispsmOptions, ParallelFade, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
+    LispsmOptions, ParallelFade, TsmOptions, UniformOptions, WarpError, XpsmOptions, lispsm, tsm,
     uniform_focused, warped_cascades, xpsm,
 };
 
@@ -27,6 +27,17 @@ fn round_trip<T: Serialize + DeserializeOwned + PartialEq + Debug>(value: &T) {
 fn rejects<T: DeserializeOwned + Debug>(json: &str) {
     let result = serde_json::from_str::<T>(json);
     assert!(result.is_err(), "{json} gave {result:?}");
+}
+
+/// Deserializing `json` as `T` fails with the message of the typed error `expected`.
+fn rejects_with<T: DeserializeOwned + Debug>(json: &str, expected: impl Display) {
+    match serde_json::from_str::<T>(json) {
+        Ok(value) => panic!("{json} gave {value:?}"),
+        Err(e) => assert!(
+            e.to_string().contains(&expected.to_string()),
+            "{json}: {e}, expected {expected}"
+        ),
+    }
 }
 
 proptest! {
@@ -51,6 +62,7 @@ proptest! {
             round_trip(&shadow);
         }
         let options = TsmOptions::default().with_reversed_z(case.reversed_z);
+        round_trip(&options.fade);
         round_trip(&options);
         if let Ok(shadow) = tsm(camera, light, scene, &options) {
             round_trip(&shadow);
@@ -105,14 +117,20 @@ fn missing_option_fields_take_their_defaults() {
 #[test]
 fn bad_payloads_are_errors() {
     // Out of the documented ranges (as the builders reject them).
-    rejects::<LispsmOptions>(r#"{"eta": 1.5}"#);
-    rejects::<LispsmOptions>(r#"{"near_hint": 10.0, "far_hint": 5.0}"#);
-    rejects::<LispsmOptions>(r#"{"fade": {"start_deg": 2.0, "end_deg": 3.0}}"#);
-    rejects::<ParallelFade>(r#"{"start_deg": 95.0}"#);
-    rejects::<TsmOptions>(r#"{"focus": 1.0}"#);
-    rejects::<XpsmOptions>(r#"{"epsilon_w": 0.0}"#);
-    rejects::<XpsmOptions>(r#"{"coef": -1.0}"#);
-    rejects::<XpsmOptions>(r#"{"miner_lamp_threshold": 0.5}"#);
+    rejects_with::<LispsmOptions>(r#"{"eta": 1.5}"#, WarpError::InvalidOption);
+    rejects_with::<LispsmOptions>(
+        r#"{"near_hint": 10.0, "far_hint": 5.0}"#,
+        WarpError::InvalidOption,
+    );
+    rejects_with::<LispsmOptions>(
+        r#"{"fade": {"start_deg": 2.0, "end_deg": 3.0}}"#,
+        WarpError::InvalidOption,
+    );
+    rejects_with::<ParallelFade>(r#"{"start_deg": 95.0}"#, WarpError::InvalidOption);
+    rejects_with::<TsmOptions>(r#"{"focus": 1.0}"#, WarpError::InvalidOption);
+    rejects_with::<XpsmOptions>(r#"{"epsilon_w": 0.0}"#, WarpError::InvalidOption);
+    rejects_with::<XpsmOptions>(r#"{"coef": -1.0}"#, WarpError::InvalidOption);
+    rejects_with::<XpsmOptions>(r#"{"miner_lamp_threshold": 0.5}"#, WarpError::InvalidOption);
     // Wrong types.
     rejects::<LispsmOptions>(r#"{"eta": "strong"}"#);
     rejects::<UniformOptions>(r#"{"reversed_z": 1}"#);
