@@ -4,6 +4,26 @@
 //! The private `*Def` types mirror the public ones field for field (serde's `remote`
 //! derive builds the public type from them); the compiler checks that they match.
 
+/// `Deserialize` for a type through its private serde `remote` mirror, then a check:
+/// `__deserialize_checked!(Type, TypeDef, |value| value.validate())` reads a `Type` with
+/// `TypeDef`'s derived code and turns an `Err` of the check (any `Display` error) into
+/// the deserializer's error. Shared by the `serde` features of the `shadowmap` crates.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __deserialize_checked {
+    ($(#[$meta:meta])* $ty:ty, $def:ty, |$value:ident| $check:expr) => {
+        $(#[$meta])*
+        impl<'de> ::serde::Deserialize<'de> for $ty {
+            fn deserialize<D: ::serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+                let $value = <$def>::deserialize(deserializer)?;
+                $check
+                    .map(|()| $value)
+                    .map_err(<D::Error as ::serde::de::Error>::custom)
+            }
+        }
+    };
+}
+
 use arrayvec::ArrayVec;
 use glam::{Mat4, Vec3};
 use serde::de::Error as _;
@@ -19,14 +39,12 @@ struct CameraDef {
     reversed_z: bool,
 }
 
-/// Checked with [`Camera::validate`].
-impl<'de> Deserialize<'de> for Camera {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let camera = CameraDef::deserialize(deserializer)?;
-        camera.validate().map_err(D::Error::custom)?;
-        Ok(camera)
-    }
-}
+crate::__deserialize_checked!(
+    /// Checked with [`Camera::validate`].
+    Camera,
+    CameraDef,
+    |camera| camera.validate()
+);
 
 #[derive(Deserialize)]
 #[serde(remote = "Light")]
@@ -46,14 +64,12 @@ enum LightDef {
     },
 }
 
-/// Checked with [`Light::validate`].
-impl<'de> Deserialize<'de> for Light {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let light = LightDef::deserialize(deserializer)?;
-        light.validate().map_err(D::Error::custom)?;
-        Ok(light)
-    }
-}
+crate::__deserialize_checked!(
+    /// Checked with [`Light::validate`].
+    Light,
+    LightDef,
+    |light| light.validate()
+);
 
 #[derive(Deserialize)]
 #[serde(remote = "PredictOptions", default = "PredictOptions::default")]
@@ -64,15 +80,13 @@ struct PredictOptionsDef {
     percentile: f64,
 }
 
-/// Missing fields take their defaults; the result is checked as [`crate::predict_error`]
-/// checks it.
-impl<'de> Deserialize<'de> for PredictOptions {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let options = PredictOptionsDef::deserialize(deserializer)?;
-        options.check().map_err(D::Error::custom)?;
-        Ok(options)
-    }
-}
+crate::__deserialize_checked!(
+    /// Missing fields take their defaults; the result is checked as [`crate::predict_error`]
+    /// checks it.
+    PredictOptions,
+    PredictOptionsDef,
+    |options| options.check()
+);
 
 /// The serialized form of [`CascadeSplits`]: its depths and blend band.
 #[derive(Deserialize)]

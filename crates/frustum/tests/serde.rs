@@ -3,52 +3,26 @@
 //! error, and the `mint` and `bytemuck` conversions keep every component.
 #![cfg(feature = "serde")]
 
-use core::fmt::{Debug, Display};
+use core::fmt::Debug;
 
 use glam::{Mat4, Vec3};
 use proptest::prelude::*;
-use serde::Serialize;
-use serde::de::DeserializeOwned;
 use shadowmap_frustum::{
     Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, FrustumError,
     Light, PredictOptions, Projection, SceneBounds, ShadowMapping, Sphere, SplitScheme,
     TechniqueSelector, fit_spot, predict_error,
 };
+use shadowmap_testgen::serde_check::{rejects, rejects_with, round_trip};
 use shadowmap_testgen::{
     GenResult, aabb, arbitrary::Unstructured, camera, frustum as cases, in_range, light_direction,
     strategy,
 };
-
-/// `value` through JSON and back: equal, and the JSON names no non-finite number.
-fn round_trip<T: Serialize + DeserializeOwned + PartialEq + Debug>(value: &T) {
-    let json = serde_json::to_string(value).expect("serializes");
-    let back: T = serde_json::from_str(&json)
-        .unwrap_or_else(|e| panic!("{value:?} -> {json} does not read back: {e}"));
-    assert_eq!(&back, value, "through {json}");
-}
 
 /// Whether every float in `value` is finite (JSON has no NaN or infinity): raw
 /// generator inputs are round-tripped only then.
 fn all_finite(value: &impl Debug) -> bool {
     let text = format!("{value:?}");
     !(text.contains("NaN") || text.contains("inf"))
-}
-
-/// Deserializing `json` as `T` fails.
-fn rejects<T: DeserializeOwned + Debug>(json: &str) {
-    let result = serde_json::from_str::<T>(json);
-    assert!(result.is_err(), "{json} gave {result:?}");
-}
-
-/// Deserializing `json` as `T` fails with the message of the typed error `expected`.
-fn rejects_with<T: DeserializeOwned + Debug>(json: &str, expected: impl Display) {
-    match serde_json::from_str::<T>(json) {
-        Ok(value) => panic!("{json} gave {value:?}"),
-        Err(e) => assert!(
-            e.to_string().contains(&expected.to_string()),
-            "{json}: {e}, expected {expected}"
-        ),
-    }
 }
 
 #[derive(Clone, Debug)]

@@ -6,8 +6,7 @@
 //! derive builds the public type from them); the compiler checks that they match.
 
 use glam::Vec3;
-use serde::de::Error as _;
-use serde::{Deserialize, Deserializer};
+use serde::Deserialize;
 
 use crate::{ConeFit, IpsmOptions, SubdivisionOptions};
 
@@ -22,14 +21,12 @@ struct IpsmOptionsDef {
     reversed_z: bool,
 }
 
-/// Checked as [`IpsmPlan::new`](crate::IpsmPlan::new) checks it.
-impl<'de> Deserialize<'de> for IpsmOptions {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let options = IpsmOptionsDef::deserialize(deserializer)?;
-        options.validate().map_err(D::Error::custom)?;
-        Ok(options)
-    }
-}
+shadowmap_frustum::__deserialize_checked!(
+    /// Checked as [`IpsmPlan::new`](crate::IpsmPlan::new) checks it.
+    IpsmOptions,
+    IpsmOptionsDef,
+    |options| options.validate()
+);
 
 #[derive(Deserialize)]
 #[serde(remote = "SubdivisionOptions", default = "SubdivisionOptions::default")]
@@ -39,11 +36,9 @@ struct SubdivisionOptionsDef {
     max_segments: u32,
 }
 
-/// Checked as [`subdivide_triangle`](crate::subdivide_triangle) checks it.
-impl<'de> Deserialize<'de> for SubdivisionOptions {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let options = SubdivisionOptionsDef::deserialize(deserializer)?;
-        options.validate().map_err(D::Error::custom)?;
-        Ok(options)
-    }
-}
+shadowmap_frustum::__deserialize_checked!(
+    /// Checked as [`subdivide_triangle`](crate::subdivide_triangle) checks it.
+    SubdivisionOptions,
+    SubdivisionOptionsDef,
+    |options| options.validate()
+);

@@ -23,14 +23,12 @@ struct ImportanceOptionsDef {
     edge_weight: f32,
 }
 
-/// Checked with [`ImportanceOptions::validate`].
-impl<'de> Deserialize<'de> for ImportanceOptions {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let options = ImportanceOptionsDef::deserialize(deserializer)?;
-        options.validate().map_err(D::Error::custom)?;
-        Ok(options)
-    }
-}
+shadowmap_frustum::__deserialize_checked!(
+    /// Checked with [`ImportanceOptions::validate`].
+    ImportanceOptions,
+    ImportanceOptionsDef,
+    |options| options.validate()
+);
 
 #[derive(Deserialize)]
 #[serde(remote = "WarpOptions", default = "WarpOptions::default")]
@@ -40,14 +38,12 @@ struct WarpOptionsDef {
     temporal: f32,
 }
 
-/// Checked with [`WarpOptions::validate`].
-impl<'de> Deserialize<'de> for WarpOptions {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let options = WarpOptionsDef::deserialize(deserializer)?;
-        options.validate().map_err(D::Error::custom)?;
-        Ok(options)
-    }
-}
+shadowmap_frustum::__deserialize_checked!(
+    /// Checked with [`WarpOptions::validate`].
+    WarpOptions,
+    WarpOptionsDef,
+    |options| options.validate()
+);
 
 /// The serialized form of an [`ImportanceMap`]: its size and its cells, row-major.
 #[derive(Deserialize)]

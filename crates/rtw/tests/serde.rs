@@ -4,35 +4,13 @@
 //! error.
 #![cfg(feature = "serde")]
 
-use core::fmt::{Debug, Display};
-
 use glam::Vec2;
 use proptest::prelude::*;
-use serde::Serialize;
-use serde::de::DeserializeOwned;
 use shadowmap_rtw::{
     ImportanceMap, ImportanceOptions, OracleAxis, RtwError, RtwSubdivision, WarpMaps, WarpOptions,
 };
+use shadowmap_testgen::serde_check::{rejects_with, round_trip};
 use shadowmap_testgen::{rtw as cases, strategy};
-
-/// `value` through JSON and back: equal.
-fn round_trip<T: Serialize + DeserializeOwned + PartialEq + Debug>(value: &T) {
-    let json = serde_json::to_string(value).expect("serializes");
-    let back: T = serde_json::from_str(&json)
-        .unwrap_or_else(|e| panic!("{value:?} -> {json} does not read back: {e}"));
-    assert_eq!(&back, value, "through {json}");
-}
-
-/// Deserializing `json` as `T` fails with the message of the typed error `expected`.
-fn rejects_with<T: DeserializeOwned + Debug>(json: &str, expected: impl Display) {
-    match serde_json::from_str::<T>(json) {
-        Ok(value) => panic!("{json} gave {value:?}"),
-        Err(e) => assert!(
-            e.to_string().contains(&expected.to_string()),
-            "{json}: {e}, expected {expected}"
-        ),
-    }
-}
 
 /// `warps` through JSON: every table, density and maximum reads back bit for bit,
 /// and the next build (temporal smoothing reads the previous densities and whether

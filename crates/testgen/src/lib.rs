@@ -24,6 +24,8 @@ pub mod frustum;
 pub mod paraboloid;
 #[cfg(feature = "rtw")]
 pub mod rtw;
+#[cfg(feature = "serde")]
+pub mod serde_check;
 #[cfg(feature = "warp")]
 pub mod warp;
 

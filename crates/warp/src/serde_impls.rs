@@ -5,7 +5,6 @@
 //! The private `*Def` types mirror the public ones field for field (serde's `remote`
 //! derive builds the public type from them); the compiler checks that they match.
 
-use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serializer};
 
 use crate::{LispsmOptions, ParallelFade, TsmOptions, WarpError, XpsmOptions};
@@ -35,17 +34,12 @@ struct ParallelFadeDef {
     end_deg: f32,
 }
 
-/// Checked with [`ParallelFade::is_valid`] ([`WarpError::InvalidOption`] otherwise).
-impl<'de> Deserialize<'de> for ParallelFade {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let fade = ParallelFadeDef::deserialize(deserializer)?;
-        if fade.is_valid() {
-            Ok(fade)
-        } else {
-            Err(D::Error::custom(WarpError::InvalidOption))
-        }
-    }
-}
+shadowmap_frustum::__deserialize_checked!(
+    /// Checked with [`ParallelFade::is_valid`] ([`WarpError::InvalidOption`] otherwise).
+    ParallelFade,
+    ParallelFadeDef,
+    |fade| if fade.is_valid() { Ok(()) } else { Err(WarpError::InvalidOption) }
+);
 
 #[derive(Deserialize)]
 #[serde(remote = "LispsmOptions", default = "LispsmOptions::default")]
@@ -58,14 +52,12 @@ struct LispsmOptionsDef {
     fade: ParallelFade,
 }
 
-/// Checked as [`crate::lispsm`] checks it.
-impl<'de> Deserialize<'de> for LispsmOptions {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let options = LispsmOptionsDef::deserialize(deserializer)?;
-        options.check().map_err(D::Error::custom)?;
-        Ok(options)
-    }
-}
+shadowmap_frustum::__deserialize_checked!(
+    /// Checked as [`crate::lispsm`] checks it.
+    LispsmOptions,
+    LispsmOptionsDef,
+    |options| options.check()
+);
 
 #[derive(Deserialize)]
 #[serde(remote = "TsmOptions", default = "TsmOptions::default")]
@@ -75,14 +67,12 @@ struct TsmOptionsDef {
     fade: ParallelFade,
 }
 
-/// Checked as [`crate::tsm`] checks it.
-impl<'de> Deserialize<'de> for TsmOptions {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let options = TsmOptionsDef::deserialize(deserializer)?;
-        options.check().map_err(D::Error::custom)?;
-        Ok(options)
-    }
-}
+shadowmap_frustum::__deserialize_checked!(
+    /// Checked as [`crate::tsm`] checks it.
+    TsmOptions,
+    TsmOptionsDef,
+    |options| options.check()
+);
 
 #[derive(Deserialize)]
 #[serde(remote = "XpsmOptions", default = "XpsmOptions::default")]
@@ -93,11 +83,9 @@ struct XpsmOptionsDef {
     miner_lamp_threshold: f32,
 }
 
-/// Checked as [`crate::xpsm`] checks it.
-impl<'de> Deserialize<'de> for XpsmOptions {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let options = XpsmOptionsDef::deserialize(deserializer)?;
-        options.validate().map_err(D::Error::custom)?;
-        Ok(options)
-    }
-}
+shadowmap_frustum::__deserialize_checked!(
+    /// Checked as [`crate::xpsm`] checks it.
+    XpsmOptions,
+    XpsmOptionsDef,
+    |options| options.validate()
+);

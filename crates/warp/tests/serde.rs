@@ -3,42 +3,14 @@
 //! error.
 #![cfg(feature = "serde")]
 
-use core::fmt::{Debug, Display};
-
 use proptest::prelude::*;
-use serde::Serialize;
-use serde::de::DeserializeOwned;
 use shadowmap_frustum::{CascadeSplits, SplitScheme};
+use shadowmap_testgen::serde_check::{rejects, rejects_with, round_trip};
 use shadowmap_testgen::{strategy, warp as cases};
 use shadowmap_warp::{
     LispsmOptions, ParallelFade, TsmOptions, UniformOptions, WarpError, XpsmOptions, lispsm, tsm,
     uniform_focused, warped_cascades, xpsm,
 };
-
-/// `value` through JSON and back: equal.
-fn round_trip<T: Serialize + DeserializeOwned + PartialEq + Debug>(value: &T) {
-    let json = serde_json::to_string(value).expect("serializes");
-    let back: T = serde_json::from_str(&json)
-        .unwrap_or_else(|e| panic!("{value:?} -> {json} does not read back: {e}"));
-    assert_eq!(&back, value, "through {json}");
-}
-
-/// Deserializing `json` as `T` fails.
-fn rejects<T: DeserializeOwned + Debug>(json: &str) {
-    let result = serde_json::from_str::<T>(json);
-    assert!(result.is_err(), "{json} gave {result:?}");
-}
-
-/// Deserializing `json` as `T` fails with the message of the typed error `expected`.
-fn rejects_with<T: DeserializeOwned + Debug>(json: &str, expected: impl Display) {
-    match serde_json::from_str::<T>(json) {
-        Ok(value) => panic!("{json} gave {value:?}"),
-        Err(e) => assert!(
-            e.to_string().contains(&expected.to_string()),
-            "{json}: {e}, expected {expected}"
-        ),
-    }
-}
 
 proptest! {
     #![proptest_config(shadowmap_testgen::proptest_config())]
