@@ -64,11 +64,8 @@ pub enum CascadeFit {
 
 /// Knobs of the directional cascade fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(default)
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[non_exhaustive]
 pub struct CascadeOptions {
     /// Texels per side of each cascade's map, in `4..=65536`.

@@ -39,11 +39,8 @@ pub enum ParaboloidMode {
 
 /// Knobs of [`ParaboloidMap`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(default)
-)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[non_exhaustive]
 pub struct MapOptions {
     /// Orients the light frame's `Y` axis; when (nearly) parallel to the axis, the world
