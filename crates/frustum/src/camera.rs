@@ -10,6 +10,7 @@ pub(crate) const MIN_RELATIVE_DEPTH_RANGE: f64 = 1e-5;
 
 /// How a camera projects view space; the view looks down `-Z`.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Projection {
     /// Symmetric perspective with a finite far plane.
     Perspective {
@@ -79,6 +80,7 @@ impl Projection {
 /// View space is right-handed and looks down `-Z`; "view depth" is the distance along
 /// the viewing direction, `-z_view`.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Camera {
     /// Rigid transform from view space to world space (the camera's pose).
     pub world_from_view: Mat4,

@@ -22,6 +22,7 @@ pub const MAX_RESOLUTION: u32 = 65536;
 /// surface that is drawn into it. Often both are the scene bounds
 /// ([`SceneBounds::whole`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SceneBounds {
     /// Everything that receives shadows.
     pub receivers: Aabb,
@@ -48,6 +49,7 @@ impl SceneBounds {
 
 /// How a cascade's light-space rectangle is chosen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum CascadeFit {
     /// The light-space box of the slice (or of slice ∩ receivers): the most texels on
     /// the slice, but the map's size and texel grid change as the camera moves or
@@ -65,6 +67,8 @@ pub enum CascadeFit {
 
 /// Knobs of the directional cascade fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[non_exhaustive]
 pub struct CascadeOptions {
     /// Texels per side of each cascade's map, in `4..=65536`.
@@ -143,6 +147,7 @@ impl CascadeOptions {
 
 /// One fitted cascade.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Cascade {
     /// View depths `(near, far)` this cascade covers, blend band included.
     pub view_depth: (f32, f32),
@@ -164,6 +169,7 @@ pub struct Cascade {
 
 /// A fitted set of cascades for a directional light.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CascadeSet {
     /// One cascade per split, near to far.
     pub cascades: ArrayVec<Cascade, MAX_CASCADES>,

@@ -4,7 +4,10 @@ use crate::{Camera, CascadeSplits, FrustumError, SplitScheme, ValidCamera};
 /// depth buffer (SDSM, Lauritzen et al. 2011; the truncated view frustum of IPSM).
 ///
 /// Splitting `[min, max]` instead of `[near, far]` spends no texels on empty depth.
+#[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 pub struct DepthBounds {
     /// Smallest visible view depth.
     pub min: f32,

@@ -11,6 +11,7 @@ use crate::{Aabb, FrustumError};
 /// order bottom-left, bottom-right, top-right, top-left as seen by the camera.
 /// Planes, inward: left, right, bottom, top, near, far.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Frustum {
     /// Corners in the documented order.
     pub corners: [Vec3; 8],

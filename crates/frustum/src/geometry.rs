@@ -3,7 +3,10 @@ use glam::{DVec3, Mat4, Vec3};
 use crate::FrustumError;
 
 /// An axis-aligned bounding box, `min <= max` on every axis when valid.
+#[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 pub struct Aabb {
     /// Smallest corner.
     pub min: Vec3,
@@ -132,7 +135,10 @@ impl Aabb {
 }
 
 /// A plane `normal . p + d = 0`; points with `normal . p + d >= 0` are inside.
+#[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 pub struct Plane {
     /// Unit normal pointing to the inside half-space.
     pub normal: Vec3,
@@ -163,7 +169,10 @@ impl Plane {
 }
 
 /// A sphere.
+#[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 pub struct Sphere {
     /// Centre.
     pub center: Vec3,

@@ -71,6 +71,13 @@
 //!
 //! `std` (default) or `libm`: one of them provides float math; with `libm` and without
 //! `std` the crate is `no_std`. No builder allocates on the heap.
+//!
+//! Optional data features, all `no_std` compatible: `serde` (`Serialize` and
+//! `Deserialize` on the options and result types; [`Camera`], [`Light`],
+//! [`PredictOptions`] and [`CascadeSplits`] deserialize through their validation, so a
+//! bad payload is an error, never an invalid value), `mint` (conversions of [`Aabb`],
+//! [`Plane`] and [`Sphere`], plus glam's), `bytemuck` (`Pod` on the `#[repr(C)]` types
+//! [`Aabb`], [`Plane`], [`Sphere`] and [`DepthBounds`], plus glam's).
 
 #![cfg_attr(not(feature = "std"), no_std)]
 
@@ -90,6 +97,11 @@ pub mod projection;
 mod split;
 mod spot;
 mod valid;
+
+#[cfg(feature = "mint")]
+mod mint_impls;
+#[cfg(feature = "serde")]
+mod serde_impls;
 
 pub use body::{ConvexBody, MAX_BODY_VERTICES};
 pub use camera::{Camera, Projection};
@@ -113,3 +125,8 @@ pub use spot::{SpotShadow, fit_spot};
 pub use valid::ValidCamera;
 
 pub use glam;
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

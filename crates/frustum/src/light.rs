@@ -4,6 +4,7 @@ use crate::FrustumError;
 
 /// A light source.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum Light {
     /// Parallel rays, e.g. the sun.
     Directional {

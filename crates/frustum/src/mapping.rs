@@ -15,6 +15,7 @@ pub const UV_FROM_CLIP: Mat4 = Mat4::from_cols(
 ///
 /// `f64` so that the evaluation harness can take accurate Jacobians.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ShadowSample {
     /// Texture coordinates, `[0, 1]²` inside the map, `v` down.
     pub uv: DVec2,
@@ -36,6 +37,7 @@ pub trait ShadowMapping {
 
 /// Which way is "toward the light" for depth bias.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum LightDirection {
     /// A directional light; the vector is the (unit) direction the light travels.
     Directional(Vec3),
@@ -50,6 +52,7 @@ pub enum LightDirection {
 /// [`UV_FROM_CLIP`] times it, for the lookup (divide by `w` for perspective
 /// techniques).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ShadowTransform {
     /// The light's frame: light looks down `-Z`.
     pub light_from_world: Mat4,

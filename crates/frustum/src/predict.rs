@@ -29,6 +29,7 @@ pub const MAX_PREDICT_RAYS: usize = 1024;
 
 /// Options of [`predict_error`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
 pub struct PredictOptions {
     /// Height of the viewport in pixels (the unit of the error). Default 1080.
@@ -81,7 +82,7 @@ impl PredictOptions {
         self
     }
 
-    fn check(&self) -> Result<(), FrustumError> {
+    pub(crate) fn check(&self) -> Result<(), FrustumError> {
         let rays = u64::from(self.grid_columns) * u64::from(self.grid_rows);
         let ok = self.viewport_height > 0
             && rays > 0
@@ -98,6 +99,7 @@ impl PredictOptions {
 
 /// The predicted aliasing error of a mapping.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PredictedError {
     /// `m` at the requested percentile, in pixels per texel extent.
     pub percentile: f64,
@@ -360,6 +362,7 @@ fn smaller_singular_value(a: DVec2, b: DVec2) -> f64 {
 /// [`switch_margin`](Self::switch_margin) (relative), so the choice does not flip
 /// every frame when two candidates are close. Keep one per light across frames.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct TechniqueSelector {
     /// The index chosen last, if any.
     pub current: Option<usize>,

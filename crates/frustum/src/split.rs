@@ -20,6 +20,7 @@ pub const MAX_CASCADES: usize = 8;
 /// which does not start at `n`; the form above is the one of Zhang et al. and of
 /// Lloyd's logarithmic analysis.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum SplitScheme {
     /// Equal depth ranges.
     Uniform,
@@ -41,6 +42,7 @@ pub enum SplitScheme {
 /// cascade after the first reaches back over the blend band of its predecessor, and
 /// inside that band a renderer blends the two with [`CascadeSplits::select`].
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct CascadeSplits {
     depths: ArrayVec<f32, { MAX_CASCADES + 1 }>,
     overlap: f32,
@@ -48,6 +50,7 @@ pub struct CascadeSplits {
 
 /// The cascade for a view depth and the weight of the next cascade in the blend band.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CascadeBlend {
     /// Index of the cascade to sample.
     pub index: usize,

@@ -6,6 +6,7 @@ use crate::{Frustum, FrustumError, Light, SceneBounds, math};
 
 /// A perspective shadow map for a spot light, fitted to what the camera sees.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SpotShadow {
     /// The matrices.
     pub transform: ShadowTransform,

@@ -10,6 +10,7 @@ pub const MAX_CONE_DIRECTIONS: usize = 16;
 
 /// Which cone fit a plan uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum ConeFit {
     /// The paper's fit: axis = normalized sum of the unit directions, half-angle = the
     /// largest angle from that axis (Vanek et al., Eqs. 1 and 2). Not minimal.
@@ -23,6 +24,7 @@ pub enum ConeFit {
 /// A circular cone with its apex at the light: every direction within `half_angle` of
 /// `axis` is inside.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Cone {
     /// Unit axis (world space).
     pub axis: Vec3,

@@ -200,6 +200,12 @@
 //! `std` (default) or `libm` provide float math; with `libm` and without `std` the
 //! crate is `no_std` (it uses `alloc` only for [`subdivide_triangles`]). The plan
 //! allocates nothing.
+//!
+//! Optional data features, `no_std` compatible: `serde` (`Serialize` and
+//! `Deserialize` on the options and results; [`IpsmOptions`] and
+//! [`SubdivisionOptions`] deserialize through the builders' checks) and `mint`
+//! (glam's and `shadowmap-frustum`'s conversions), and `bytemuck` (`Pod` and
+//! `Zeroable` on [`ParaboloidUniform`], so the lookup's block uploads as is).
 
 #![cfg_attr(not(feature = "std"), no_std)]
 
@@ -210,6 +216,8 @@ mod error;
 mod map;
 mod orient;
 mod plan;
+#[cfg(feature = "serde")]
+mod serde_impls;
 mod subdivide;
 
 pub use cone::{Cone, ConeFit, MAX_CONE_DIRECTIONS, MIN_ZOOM, fit_minimal_cone, fit_paper_cone};
@@ -221,3 +229,8 @@ pub use subdivide::{
 };
 
 pub use shadowmap_frustum;
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -8,6 +8,7 @@ use crate::cone::{MIN_ZOOM, zoom_for_half_angle};
 
 /// Which paraboloid of a map.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Side {
     /// The paraboloid facing along the map's axis (light-space `-Z`); layer 0.
     Front,
@@ -28,6 +29,7 @@ impl Side {
 
 /// How many paraboloids a map renders.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum ParaboloidMode {
     /// One front paraboloid, cut by the zoom factor to the light cone.
     Single,
@@ -37,6 +39,8 @@ pub enum ParaboloidMode {
 
 /// Knobs of [`ParaboloidMap`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[non_exhaustive]
 pub struct MapOptions {
     /// Orients the light frame's `Y` axis; when (nearly) parallel to the axis, the world
@@ -74,6 +78,7 @@ impl MapOptions {
 /// The disc of a paraboloid map's texture where the map is guaranteed meaningful: the
 /// image of the light cone (of the hemisphere for a dual map).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct UsableDisc {
     /// Centre in texture coordinates, `(0.5, 0.5)`.
     pub center: Vec2,
@@ -109,6 +114,7 @@ impl UsableDisc {
 /// The back map mirrors `x`, so each side looks like a camera facing its way with
 /// the same up vector.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ParaboloidMap {
     /// Rigid light frame; the front paraboloid faces `-Z`.
     pub light_from_world: Mat4,

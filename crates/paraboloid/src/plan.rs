@@ -12,6 +12,7 @@ use crate::orient::dual_axis;
 
 /// Knobs of [`IpsmPlan`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
 pub struct IpsmOptions {
     /// Which cone fit decides the rotation, the cut and single versus dual. Default
@@ -84,7 +85,7 @@ impl IpsmOptions {
         self
     }
 
-    fn validate(&self) -> Result<(), ParaboloidError> {
+    pub(crate) fn validate(&self) -> Result<(), ParaboloidError> {
         let m = self.margin;
         let a = self.max_single_half_angle;
         if !(m.is_finite() && a.is_finite() && self.near.is_finite() && self.up_hint.is_finite()) {
@@ -101,6 +102,7 @@ impl IpsmOptions {
 
 /// Why a plan renders two paraboloids.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum DualReason {
     /// The light lies inside the truncated frustum (exact fit: the origin is in the
     /// convex hull of the directions; paper fit: inside all six planes).
@@ -130,6 +132,7 @@ pub enum DualReason {
 /// plan picks the axis whose seam carries the view (see the crate docs, "The dual
 /// fallback").
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct IpsmPlan {
     /// The map to render (single or dual) and to look up.
     pub map: ParaboloidMap,

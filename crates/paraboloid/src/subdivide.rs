@@ -8,6 +8,7 @@ use crate::map::{ParaboloidMap, Side};
 
 /// Knobs of [`edge_subdivisions`] and [`subdivide_triangle`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
 pub struct SubdivisionOptions {
     /// Shadow-map resolution (texels per side), in `1..=65536`. Default 1024.
@@ -50,7 +51,7 @@ impl SubdivisionOptions {
         self
     }
 
-    fn validate(&self) -> Result<(), ParaboloidError> {
+    pub(crate) fn validate(&self) -> Result<(), ParaboloidError> {
         let t = self.tolerance_texels;
         if !t.is_finite() {
             return Err(ParaboloidError::NonFinite);

@@ -13,7 +13,10 @@ pub const MAX_MAP_SIDE: u32 = 16384;
 pub const MAX_MAP_CELLS: usize = 1 << 24;
 
 /// A surface point seen by the eye, for backward analysis and the oracle.
+#[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 pub struct EyeSample {
     /// World position.
     pub position: Vec3,
@@ -36,6 +39,7 @@ pub struct EyeSample {
 /// with `d` the eye distance (backward) or view depth (forward), `n` the unit normal
 /// and `l` the unit direction toward the light.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
 pub struct ImportanceOptions {
     /// Distance at which the distance term is 1; positive and finite.
@@ -127,6 +131,7 @@ impl ImportanceOptions {
 
 /// What an accumulation did with its samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct AccumulateStats {
     /// Samples written into a cell.
     pub accepted: usize,
@@ -193,6 +198,7 @@ impl Base {
 /// Values are always finite and non-negative (every writer checks), so the warp
 /// builder need not. Accumulation keeps the maximum per cell.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ImportanceMap {
     width: u32,
     height: u32,
@@ -577,6 +583,7 @@ impl ImportanceMap {
 
 /// Which requirement [`ImportanceMap::accumulate_oracle_axis`] records.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum OracleAxis {
     /// The same density on both axes: `1 / s_min(J)`.
     Isotropic,
@@ -613,7 +620,7 @@ fn check_size(width: u32, height: u32) -> Result<usize, RtwError> {
     Ok(len)
 }
 
-fn check_value(v: f32) -> Result<(), RtwError> {
+pub(crate) fn check_value(v: f32) -> Result<(), RtwError> {
     if !v.is_finite() {
         Err(RtwError::NonFinite)
     } else if v < 0.0 {

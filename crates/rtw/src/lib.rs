@@ -126,6 +126,12 @@
 //!
 //! `std` (default) or `libm` for float math; without `std` the crate is `no_std` and
 //! needs `alloc` (the importance map and warp buffers live on the heap, allocated once).
+//!
+//! Optional data features, `no_std` compatible: `serde` (`Serialize` and
+//! `Deserialize` on the options, samples and maps; an [`ImportanceMap`] or
+//! [`WarpMaps`] payload is validated, and warp tables must be the ones built from the
+//! payload's densities), `mint` (glam's and `shadowmap-frustum`'s conversions) and
+//! `bytemuck` (`Pod` on the `#[repr(C)]` [`EyeSample`], plus glam's).
 
 #![cfg_attr(not(feature = "std"), no_std)]
 
@@ -133,6 +139,8 @@ extern crate alloc;
 
 mod error;
 mod importance;
+#[cfg(feature = "serde")]
+mod serde_impls;
 mod subdivide;
 mod table;
 mod warp;
@@ -147,3 +155,8 @@ pub use table::{
     forward_warp, forward_warp_f64, inverse_warp, inverse_warp_f64, sample_table, sample_table_f64,
 };
 pub use warp::{MAX_BLUR_RADIUS, MIN_FLOOR, RtwShadow, WarpMaps, WarpOptions, gaussian_weights};
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -18,6 +18,8 @@ use crate::{RtwShadow, forward_warp_f64};
 
 /// How finely [`subdivide_for_rtw`] splits casters.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[non_exhaustive]
 pub struct RtwSubdivision {
     /// Texels per side of the shadow map the casters are rendered into (the error

@@ -9,6 +9,9 @@ use crate::RtwError;
 use crate::importance::{ImportanceMap, MAX_MAP_CELLS, MAX_MAP_SIDE};
 use crate::table::{forward_warp, forward_warp_f64, inverse_warp};
 
+#[cfg(feature = "serde")]
+mod serde_impls;
+
 /// Largest accepted blur radius (cells).
 pub const MAX_BLUR_RADIUS: u32 = 64;
 /// Smallest accepted importance floor.
@@ -16,6 +19,7 @@ pub const MIN_FLOOR: f32 = 1e-6;
 
 /// Knobs of the importance-to-warp step.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
 pub struct WarpOptions {
     /// Radius of the Gaussian blur of each 1-D map, in cells, `0..=`[`MAX_BLUR_RADIUS`]
@@ -83,6 +87,7 @@ impl WarpOptions {
 /// per-frame work does not allocate. The `x` table has one texel per importance-map
 /// column and warps `u`; the `y` table one per row and warps `v`.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct WarpMaps {
     x: Vec<f32>,
     y: Vec<f32>,
@@ -90,6 +95,7 @@ pub struct WarpMaps {
     row_max: Vec<f32>,
     density_x: Vec<f32>,
     density_y: Vec<f32>,
+    #[cfg_attr(feature = "serde", serde(skip))]
     scratch: Vec<f64>,
     has_history: bool,
     fallback: [bool; 2],

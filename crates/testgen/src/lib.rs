@@ -24,6 +24,8 @@ pub mod frustum;
 pub mod paraboloid;
 #[cfg(feature = "rtw")]
 pub mod rtw;
+#[cfg(feature = "serde")]
+pub mod serde_check;
 #[cfg(feature = "warp")]
 pub mod warp;
 
@@ -415,3 +417,8 @@ pub fn split_scheme_raw(u: &mut Unstructured<'_>, count: usize) -> GenResult<Spl
         },
     })
 }
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -8,6 +8,7 @@ use crate::{FocusBody, LispsmOptions, LispsmShadow, SceneBounds, WarpError};
 
 /// One cascade of a warped-cascade fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct WarpedCascade {
     /// View depth where the cascade starts (including the blend band it shares with
     /// its predecessor).
@@ -21,6 +22,7 @@ pub struct WarpedCascade {
 
 /// The cascades of [`warped_cascades`], near to far.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct WarpedCascades {
     /// One entry per split.
     pub cascades: ArrayVec<WarpedCascade, MAX_CASCADES>,

@@ -24,6 +24,7 @@ pub const MAX_WARP_RATIO: f64 = 1.0e4;
 /// of a directional light degenerates; Filament guards the same case). Shared by
 /// LiSPSM and TSM.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ParallelFade {
     /// Angle (degrees) between view and light above which the warp has full strength.
     pub start_deg: f32,

@@ -138,6 +138,12 @@
 //!
 //! `std` (default) or `libm` provides float math; without `std` the crate is
 //! `no_std`. No builder allocates on the heap.
+//!
+//! Optional data features, all `no_std` compatible: `serde` (`Serialize` and
+//! `Deserialize` on the options and results; options deserialize through the
+//! builders' checks, and an unbounded value such as the default
+//! [`LispsmOptions::far_hint`] is written as none), `mint` and `bytemuck` (glam's and
+//! `shadowmap-frustum`'s).
 
 #![cfg_attr(not(feature = "std"), no_std)]
 
@@ -145,6 +151,8 @@ mod cascades;
 mod error;
 mod focus;
 mod lispsm;
+#[cfg(feature = "serde")]
+mod serde_impls;
 mod tsm;
 mod uniform;
 mod xpsm;
@@ -179,3 +187,8 @@ pub fn light_frame(camera: &Camera, light_direction: Vec3) -> Result<Mat4, WarpE
     let light = focus::light_unit(light_direction)?;
     Ok(focus::frame(light, view.forward, view.up).0.as_mat4())
 }
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -12,6 +12,7 @@ use crate::{MAX_WARP_RATIO, ParallelFade, SceneBounds};
 
 /// Options of [`lispsm`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
 pub struct LispsmOptions {
     /// Depth 1 at the light's near plane and 0 at its far plane.
@@ -25,6 +26,10 @@ pub struct LispsmOptions {
     /// View depth beyond which shadows matter little: `n_opt` uses
     /// `min(z_far, far_hint)`. Default infinity (none). Must not be below
     /// [`near_hint`](Self::near_hint) ([`WarpError::InvalidOption`]).
+    #[cfg_attr(
+        feature = "serde",
+        serde(with = "crate::serde_impls::infinite_as_none")
+    )]
     pub far_hint: f32,
     /// The parallel-light fade band (default: full strength above 10 degrees,
     /// uniform below 3).
@@ -96,11 +101,16 @@ impl LispsmOptions {
 
 /// A LiSPSM fit: the matrices and the warp it chose.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct LispsmShadow {
     /// The matrices (depth pass and lookup).
     pub transform: ShadowTransform,
     /// Distance `n` from the projection centre to the near face of the body along
     /// the warp axis; infinite when the fit is uniform.
+    #[cfg_attr(
+        feature = "serde",
+        serde(with = "crate::serde_impls::infinite_as_none")
+    )]
     pub n: f32,
     /// Parallel-light fade weight in `[0, 1]` (1: full warp, 0: uniform).
     pub fade: f32,

@@ -12,6 +12,7 @@ use crate::{ParallelFade, SceneBounds};
 
 /// Options of [`tsm`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
 pub struct TsmOptions {
     /// Depth 1 at the light's near plane and 0 at its far plane.
@@ -63,7 +64,7 @@ impl TsmOptions {
         self
     }
 
-    fn check(&self) -> Result<(), WarpError> {
+    pub(crate) fn check(&self) -> Result<(), WarpError> {
         let ok = self.focus > 0.0 && self.focus < 1.0 && self.fade.is_valid();
         if ok {
             Ok(())
@@ -75,11 +76,16 @@ impl TsmOptions {
 
 /// A TSM fit: the matrices and the trapezoid's projection distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct TsmShadow {
     /// The matrices (depth pass and lookup).
     pub transform: ShadowTransform,
     /// `η`: distance from the trapezoid's apex (the projection centre) to its top
     /// edge along the centre line; infinite when the trapezoid is a rectangle.
+    #[cfg_attr(
+        feature = "serde",
+        serde(with = "crate::serde_impls::infinite_as_none")
+    )]
     pub eta: f32,
 }
 

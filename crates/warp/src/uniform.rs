@@ -10,6 +10,8 @@ use crate::{SceneBounds, WarpError};
 
 /// Options of [`uniform_focused`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[non_exhaustive]
 pub struct UniformOptions {
     /// Depth 1 at the light's near plane and 0 at its far plane.

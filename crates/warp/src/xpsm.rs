@@ -10,6 +10,7 @@ use crate::focus::{Bounds, Focus, View, finish, footprint_weight, scale_of, smoo
 
 /// Options of [`xpsm`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
 pub struct XpsmOptions {
     /// Depth 1 at the light's near plane and 0 at its far plane.
@@ -77,7 +78,7 @@ impl XpsmOptions {
         self
     }
 
-    fn validate(&self) -> Result<(), WarpError> {
+    pub(crate) fn validate(&self) -> Result<(), WarpError> {
         let coef_ok = match self.coef {
             Some(c) => c.is_finite() && c >= 0.0,
             None => true,
@@ -98,6 +99,7 @@ impl XpsmOptions {
 /// An XPSM fit: the matrices, the Z bias scale of step 18, and the quantities the
 /// algorithm chose.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct XpsmShadow {
     /// The matrices (depth pass and lookup).
     pub transform: ShadowTransform,
@@ -109,6 +111,10 @@ pub struct XpsmShadow {
     /// Length of the projection vector after clipping (0: orthographic).
     pub length_p: f32,
     /// The back-projection bound `maxLengthP` (infinite when there is none).
+    #[cfg_attr(
+        feature = "serde",
+        serde(with = "crate::serde_impls::infinite_as_none")
+    )]
     pub max_length_p: f32,
     /// Miner's-lamp weight in `[0, 1]`: 1 is full warp, 0 the miner's-lamp case
     /// (orthographic with focusing).
