@@ -147,6 +147,7 @@ mod focus;
 mod lispsm;
 mod tsm;
 mod uniform;
+mod warped_mapping;
 mod xpsm;
 
 pub use cascades::{WarpedCascade, WarpedCascades, warped_cascades};
@@ -157,6 +158,7 @@ pub use shadowmap_frustum::SceneBounds;
 pub use shadowmap_frustum::{ShadowTransform, glam};
 pub use tsm::{TsmOptions, TsmShadow, tsm};
 pub use uniform::{UniformOptions, uniform_focused};
+pub use warped_mapping::WarpedCascadesView;
 pub use xpsm::{XpsmOptions, XpsmShadow, xpsm};
 
 use glam::{Mat4, Vec3};
