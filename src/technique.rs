@@ -36,11 +36,11 @@ pub enum Technique {
         /// The per-cascade warp (its `eta` is the strength of every cascade).
         lispsm: LispsmOptions,
     },
-    /// The candidate of [`AUTO_CANDIDATE_COUNT`](crate::AUTO_CANDIDATE_COUNT) (uniform, LiSPSM, TSM,
-    /// XPSM and the three cascaded techniques with this plan) with the lowest error
-    /// predicted from the camera, light and bounds alone, with hysteresis across
-    /// frames through a caller-held selector ([`fit_with_selector`](crate::fit_with_selector)).
-    /// Directional light.
+    /// The candidate of [`auto_candidates`](crate::auto_candidates) (uniform,
+    /// LiSPSM, TSM, XPSM and the three cascaded techniques with this plan) with the
+    /// lowest error predicted from the camera, light and bounds alone, with
+    /// hysteresis across frames through a caller-held selector
+    /// ([`fit_with_selector`](crate::fit_with_selector)). Directional light.
     Auto(CascadePlan),
     /// Rectilinear texture warping (Rosen) over the uniform fit, importance from the
     /// eye's samples (backward analysis). Directional light.

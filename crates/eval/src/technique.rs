@@ -1,10 +1,11 @@
 //! The techniques under comparison, built for one frame of a configuration at an
 //! equal texel budget.
 //!
-//! [`TechniqueKind`] lists them; [`Technique::build`] fits one to a frame
-//! ([`FrameContext`]: camera, light, scene bounds, the eye's visible samples) and
-//! returns something that is both a [`ShadowMapping`] (the lookup the metrics
-//! measure) and a depth pass for the reference rasterizer
+//! [`TechniqueKind`] lists them, each an umbrella [`shadowmap::Technique`] value
+//! ([`TechniqueKind::technique`]); [`Technique::build`] fits one to a frame
+//! ([`FrameContext`]: camera, light, scene bounds, the eye's visible samples) with
+//! [`shadowmap::fit`] and returns something that is both a [`ShadowMapping`] (the
+//! lookup the metrics measure) and a depth pass for the reference rasterizer
 //! ([`Technique::rasterize`]), with its per-layer resolution.
 //!
 //! | light | techniques |

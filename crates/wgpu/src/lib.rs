@@ -134,6 +134,7 @@ pub use context::{BackendError, GpuContext};
 // --- depth passes, uniforms, lookup, headless renderer (one author) ---
 pub mod depth;
 pub mod render;
+pub mod shadow;
 pub mod uniforms;
 
 // --- compute passes: depth reduction, RTW pipeline (another author) ---
