@@ -1,8 +1,8 @@
 // techniques: rtw
 // Depth pass of rectilinear texture warping: the base projection, then each texture
 // axis warped through its table. The tables are filtered by hand with the exact
-// texel-centre linear, clamp-to-edge semantics of `shadowmap_rtw::forward_warp`, so
-// the CPU and the GPU agree to the last bit (up to fused multiply-adds). Casters
+// texel-centre linear, clamp-to-edge semantics of `shadowmap_rtw::forward_warp`
+// (the sampler of rtw_sample.wgsl, composed in), so the CPU and the GPU agree. Casters
 // must be subdivided: the warp is piecewise linear between table texel centres.
 //
 // The warped position is snapped to the rasterizer's 1/256-pixel grid here. Where the
@@ -28,24 +28,12 @@ const SUBPIXEL_STEPS: f32 = 256.0;
 // The u table, then the v table.
 @group(0) @binding(1) var<storage, read> rtw_tables: array<f32>;
 
-// S(u) of the table at `offset` with `n` texels (shadowmap_rtw::sample_table).
+// @compose rtw_sample begin
+// Placeholder: the sampler of rtw_sample.wgsl is composed in here.
 fn rtw_sample(offset: u32, n: u32, u: f32) -> f32 {
-    if n == 0u {
-        return 0.0;
-    }
-    let x = u * f32(n) - 0.5;
-    if !(x > 0.0) {
-        return rtw_tables[offset];
-    }
-    if x >= f32(n - 1u) {
-        return rtw_tables[offset + n - 1u];
-    }
-    let i = u32(x);
-    let f = x - f32(i);
-    let a = rtw_tables[offset + i];
-    let b = rtw_tables[offset + min(i + 1u, n - 1u)];
-    return a + f * (b - a);
+    return 0.0;
 }
+// @compose rtw_sample end
 
 @vertex
 fn vs_main(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {

@@ -1,7 +1,7 @@
 // techniques: rtw
 // Shadow lookup of rectilinear texture warping: the base projection's uv, each axis
 // warped through its table with the exact semantics of `shadowmap_rtw::forward_warp`
-// (hand-filtered, texel-centre linear, clamp to edge), depth from the base.
+// (hand-filtered by the sampler of rtw_sample.wgsl, composed in), depth from the base.
 // Same interface as lookup_matrix.wgsl.
 
 struct RtwShadow {
@@ -15,24 +15,12 @@ struct RtwShadow {
 // The u table, then the v table.
 @group(1) @binding(1) var<storage, read> rtw_tables: array<f32>;
 
-// S(u) of the table at `offset` with `n` texels (shadowmap_rtw::sample_table).
+// @compose rtw_sample begin
+// Placeholder: the sampler of rtw_sample.wgsl is composed in here.
 fn rtw_sample(offset: u32, n: u32, u: f32) -> f32 {
-    if n == 0u {
-        return 0.0;
-    }
-    let x = u * f32(n) - 0.5;
-    if !(x > 0.0) {
-        return rtw_tables[offset];
-    }
-    if x >= f32(n - 1u) {
-        return rtw_tables[offset + n - 1u];
-    }
-    let i = u32(x);
-    let f = x - f32(i);
-    let a = rtw_tables[offset + i];
-    let b = rtw_tables[offset + min(i + 1u, n - 1u)];
-    return a + f * (b - a);
+    return 0.0;
 }
+// @compose rtw_sample end
 
 fn shadow_lookup(world: vec3<f32>, view_depth: f32, world_bias: f32, second: bool) -> vec4<f32> {
     let h = shadow.uv_from_world * vec4<f32>(world, 1.0);

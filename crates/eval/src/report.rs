@@ -17,14 +17,22 @@
 //! smallest resolvable depth, the same for every technique) and the lookup
 //! `1e-5` depth units; nearest-texel lookups, no filtering.
 //!
-//! Output in [`Options::out`]: `report.md`, `metrics.csv`, `legend.png`, and per
-//! technique and configuration `heatmap_<config>_<technique>.png` (aliasing error
-//! over the screen) and `mask_<config>_<technique>.png` (three panels: the
-//! technique's shadow mask, the ray-traced mask, the misclassified pixels, over the
-//! pixels the misclassification counts; the others background grey). With
+//! Output in [`Options::out`]: `index.html` (the page to read: every table,
+//! picture and plot below, labelled, with the definitions; self-contained, it opens
+//! from disk), `report.md`, `metrics.csv`, `legend.png` and `colorbar.svg` (the
+//! heatmaps' colour scale), per configuration `aliasing_<config>.svg` (the p95 of
+//! the aliasing error per view-depth slice of every technique, with the
+//! pixel-matched and logarithmic limits, drawn with `plotters`), and per technique
+//! and configuration `heatmap_<config>_<technique>.png` (aliasing error over the
+//! screen) and `mask_<config>_<technique>.png` (three panels: the technique's
+//! shadow mask, the ray-traced mask, the misclassified pixels, over the pixels the
+//! misclassification counts; the others background grey). With
 //! [`Options::sweep`], the sweep's rows join `metrics.csv` (their `config` is the
-//! sweep case, `random_<scene>_<k>`) and `report.md` ends with the sweep's wins,
-//! ties and losses per technique; the sweep writes no pictures.
+//! sweep case, `random_<scene>_<k>`), `report.md` ends with the sweep's wins, ties
+//! and losses per technique and `sweep.svg` plots them; the sweep writes no other
+//! pictures. The images the wgpu backend's `render_scene` example writes into
+//! `rendered/` of the report directory are kept from one report to the next and
+//! shown on the page.
 //!
 //! The output is all or nothing: every input (options, mesh file, output directory)
 //! is checked before the first configuration is evaluated, the files are written
@@ -50,8 +58,10 @@
 //! Jacobians. `legend.png` shows the scale.
 
 mod evaluate;
+mod html;
 mod image;
 mod output;
+mod plots;
 mod runner;
 mod sweep;
 mod text;
@@ -84,8 +94,12 @@ pub struct Options {
     pub sweep: usize,
     /// Worker threads (at least 1).
     pub threads: usize,
-    /// Show a progress bar on stderr.
+    /// Show a progress bar on stderr (for a terminal): the current configuration
+    /// and technique, and an estimate of the time left.
     pub progress: bool,
+    /// Print one line on stderr per finished configuration (for logs and pipes,
+    /// where a bar would not show).
+    pub progress_lines: bool,
 }
 
 impl Default for Options {
@@ -98,6 +112,7 @@ impl Default for Options {
             sweep: 0,
             threads: 2,
             progress: false,
+            progress_lines: false,
         }
     }
 }
@@ -143,6 +158,12 @@ impl Options {
     #[must_use]
     pub const fn with_progress(mut self, progress: bool) -> Self {
         self.progress = progress;
+        self
+    }
+    /// With or without one progress line per finished configuration.
+    #[must_use]
+    pub const fn with_progress_lines(mut self, lines: bool) -> Self {
+        self.progress_lines = lines;
         self
     }
 }

@@ -1,6 +1,7 @@
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 
 use crate::frustum::{dplanes, f32_min_distance};
+use crate::geometry::DPlane;
 use crate::{Frustum, FrustumError, math, projection};
 
 /// Smallest accepted relative thickness `(far - near) / far` of a depth range: below
@@ -271,7 +272,18 @@ impl Camera {
     /// # Errors
     /// As [`Camera::validate`].
     pub fn clip_from_world(&self) -> Result<Mat4, FrustumError> {
+        self.clip_from_geometry(&self.geometry()?)
+    }
+
+    /// The geometry with every check of [`Camera::validate`] passed (computed once).
+    pub(crate) fn checked_geometry(&self) -> Result<CameraGeometry, FrustumError> {
         let g = self.geometry()?;
+        self.clip_from_geometry(&g)?;
+        Ok(g)
+    }
+
+    /// [`Camera::clip_from_world`] from this camera's geometry.
+    fn clip_from_geometry(&self, g: &CameraGeometry) -> Result<Mat4, FrustumError> {
         let exact = self.projection_matrix().as_dmat4() * g.view_from_world();
         let m = exact.as_mat4();
         if resolves_depth_range(&m, &exact, &g.world_corners(g.near, g.far)) {
@@ -286,8 +298,7 @@ impl Camera {
     /// # Errors
     /// As [`Camera::validate`].
     pub fn frustum(&self) -> Result<Frustum, FrustumError> {
-        let g = self.geometry()?;
-        g.slice(g.near, g.far)
+        Ok(self.geometry()?.frustum())
     }
 
     /// The sub-frustum between view depths `near_depth < far_depth`, which must lie
@@ -377,6 +388,10 @@ pub(crate) struct CameraGeometry {
     /// top-right, top-left.
     pub(crate) ray_origin: [DVec3; 4],
     pub(crate) ray_dir: [DVec3; 4],
+    /// World corners of the whole depth range (`world_corners(near, far)`).
+    corners: [DVec3; 8],
+    /// Their inward planes (`dplanes(&corners, 0.0)`), as validation found them.
+    planes: [DPlane; 6],
 }
 
 fn finite(x: f32) -> Result<f64, FrustumError> {
@@ -509,12 +524,17 @@ impl CameraGeometry {
                 shadow_distance,
             } => Self::custom_rays(&clip_from_view, shadow_distance, camera.reversed_z)?,
         };
-        let geometry = Self {
+        let mut geometry = Self {
             world_from_view,
             near,
             far,
             ray_origin,
             ray_dir,
+            corners: [DVec3::ZERO; 8],
+            planes: [DPlane {
+                normal: DVec3::Z,
+                d: 0.0,
+            }; 6],
         };
         // The frustum must keep its volume once its corners are rounded to f32.
         let corners = geometry.world_corners(near, far);
@@ -531,7 +551,8 @@ impl CameraGeometry {
         dplanes(&rounded, f32_min_distance(&rounded))?;
         // ...and every builder's own construction of it must succeed too (the `f32`
         // corners are finite, checked above).
-        dplanes(&corners, 0.0)?;
+        geometry.planes = dplanes(&corners, 0.0)?;
+        geometry.corners = corners;
         Ok(geometry)
     }
 
@@ -652,6 +673,15 @@ impl CameraGeometry {
     pub(crate) fn world_corners(&self, near: f64, far: f64) -> [DVec3; 8] {
         self.view_corners(near, far)
             .map(|c| self.world_from_view.transform_point3(c))
+    }
+
+    /// The frustum of the whole depth range, from the corners and planes validation
+    /// computed (the same values [`CameraGeometry::slice`] gives for it).
+    pub(crate) fn frustum(&self) -> Frustum {
+        Frustum {
+            corners: self.corners.map(DVec3::as_vec3),
+            planes: self.planes.map(DPlane::to_plane),
+        }
     }
 
     pub(crate) fn slice(&self, near: f64, far: f64) -> Result<Frustum, FrustumError> {

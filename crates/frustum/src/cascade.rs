@@ -2,11 +2,14 @@ use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
 
 use crate::body::ConvexBody;
+use crate::bounding_sphere::bounding_sphere;
 use crate::camera::CameraGeometry;
 use crate::light::unit;
 use crate::mapping::{LightDirection, ShadowSample, ShadowTransform, project_dmat};
 use crate::split::CascadeBlend;
-use crate::{Aabb, Camera, CascadeSplits, FrustumError, MAX_CASCADES, ShadowMapping, math};
+use crate::{
+    Aabb, Camera, CascadeSplits, FrustumError, MAX_CASCADES, ShadowMapping, ValidCamera, math,
+};
 
 /// Largest accepted shadow-map resolution (texels per side).
 pub const MAX_RESOLUTION: u32 = 65536;
@@ -192,8 +195,27 @@ impl CascadeSet {
         splits: &CascadeSplits,
         options: &CascadeOptions,
     ) -> Result<Self, FrustumError> {
-        let fitter = Fitter::new(camera, light_direction, options)?;
-        let mut cascades = ArrayVec::new();
+        Self::fit_valid(&ValidCamera::new(camera)?, light_direction, splits, options)
+    }
+
+    /// As [`CascadeSet::fit`] for a camera validated once per frame (see
+    /// [`ValidCamera`]): the same cascades, without checking the camera again.
+    ///
+    /// # Errors
+    /// As [`CascadeSet::fit`], except the camera's.
+    pub fn fit_valid(
+        camera: &ValidCamera,
+        light_direction: Vec3,
+        splits: &CascadeSplits,
+        options: &CascadeOptions,
+    ) -> Result<Self, FrustumError> {
+        let fitter = Fitter::new(&camera.geometry, light_direction, options)?;
+        let mut set = Self {
+            cascades: ArrayVec::new(),
+            splits: splits.clone(),
+            view_from_world: camera.geometry.view_from_world().as_mat4(),
+            resolution: options.resolution,
+        };
         for i in 0..splits.count() {
             let (near, far) = splits
                 .cascade_range(i)
@@ -206,14 +228,9 @@ impl CascadeSet {
                 }
                 other => other?,
             };
-            cascades.push(cascade);
+            set.cascades.push(cascade);
         }
-        Ok(Self {
-            cascades,
-            splits: splits.clone(),
-            view_from_world: fitter.camera.view_from_world().as_mat4(),
-            resolution: options.resolution,
-        })
+        Ok(set)
     }
 
     /// The cascade for a world point by its view depth, with the blend weight toward
@@ -262,15 +279,16 @@ pub fn fit_cascade(
     far_depth: f32,
     options: &CascadeOptions,
 ) -> Result<Cascade, FrustumError> {
-    let fitter = Fitter::new(camera, light_direction, options)?;
+    let geometry = camera.geometry()?;
+    let fitter = Fitter::new(&geometry, light_direction, options)?;
     let (n, f) = fitter.camera.check_slice(near_depth, far_depth)?;
     fitter.fit(n as f32, f as f32)
 }
 
 /// Everything a cascade fit needs that does not depend on the slice, computed once
 /// per call of [`CascadeSet::fit`].
-struct Fitter {
-    camera: CameraGeometry,
+struct Fitter<'a> {
+    camera: &'a CameraGeometry,
     light_dir: DVec3,
     light_from_world: DMat4,
     /// `light_from_world` in `f32`, as stored in every cascade.
@@ -287,13 +305,12 @@ struct Fitter {
     scene: Option<SceneBounds>,
 }
 
-impl Fitter {
+impl<'a> Fitter<'a> {
     fn new(
-        camera: &Camera,
+        camera: &'a CameraGeometry,
         light_direction: Vec3,
         options: &CascadeOptions,
     ) -> Result<Self, FrustumError> {
-        let camera = camera.geometry()?;
         let light_dir = unit(light_direction)?;
         if !(4..=MAX_RESOLUTION).contains(&options.resolution) {
             return Err(FrustumError::InvalidResolution);
@@ -318,16 +335,20 @@ impl Fitter {
             light_from_world,
             light_from_world32: light_from_world.as_mat4(),
             light_from_view,
-            light_ray_origin: camera
-                .ray_origin
-                .map(|o| light_from_view.transform_point3(o)),
-            light_ray_dir: camera.ray_dir.map(|d| light_from_view.transform_vector3(d)),
-            world_ray_origin: camera
-                .ray_origin
-                .map(|o| camera.world_from_view.transform_point3(o)),
-            world_ray_dir: camera
-                .ray_dir
-                .map(|d| camera.world_from_view.transform_vector3(d)),
+            light_ray_origin: core::array::from_fn(|i| {
+                light_from_view.transform_point3(camera.ray_origin[i])
+            }),
+            light_ray_dir: core::array::from_fn(|i| {
+                light_from_view.transform_vector3(camera.ray_dir[i])
+            }),
+            world_ray_origin: core::array::from_fn(|i| {
+                camera
+                    .world_from_view
+                    .transform_point3(camera.ray_origin[i])
+            }),
+            world_ray_dir: core::array::from_fn(|i| {
+                camera.world_from_view.transform_vector3(camera.ray_dir[i])
+            }),
             options: *options,
             scene,
         })
@@ -436,7 +457,7 @@ impl Fitter {
         } else {
             (near_dist, far_dist)
         };
-        let clip_from_light = crate::projection::orthographic(
+        let clip_from_world = crate::projection::orthographic_times_affine(
             xy_lo.x,
             xy_hi.x,
             xy_lo.y,
@@ -444,8 +465,9 @@ impl Fitter {
             near_dist,
             far_dist,
             self.options.reversed_z,
-        );
-        let clip_from_world = (clip_from_light * *light).as_mat4();
+            light,
+        )
+        .as_mat4();
         if !crate::is_invertible(&clip_from_world, reach.max(depth_scale) as f32) {
             return Err(FrustumError::DegenerateFrustum);
         }
@@ -528,270 +550,4 @@ fn caster_depth_over(
         range = Some(range.map_or((d, d), |(a, b)| (a.min(d), b.max(d))));
     }
     Ok(range)
-}
-
-/// The minimal bounding sphere of a slice among those centred on the segment between
-/// its near and far face centroids, from its view-space corners. It depends only on
-/// the projection and the depths, never on the camera's pose, so its radius is exactly
-/// invariant under camera rotation.
-///
-/// With `c(t)` the point at `t` along the segment `d` (from the near centroid `c_n`
-/// to the far centroid `c_f`) and `p_i` the corners, the squared distances share
-/// their quadratic term:
-///
-/// ```text
-/// |c(t) - p_i|^2 = |d|^2 t^2 - 2 t d.(p_i - c_n) + |p_i - c_n|^2
-/// ```
-///
-/// so their maximum is `|d|^2 t^2` plus an upper envelope of lines, a convex function.
-/// When the segment is perpendicular to both faces and each face's corners are
-/// equidistant from its centroid (every symmetric perspective slice and every
-/// orthographic one), only two of those lines differ and the minimum is closed-form:
-///
-/// ```text
-/// t = clamp((|d|^2 + r_f^2 - r_n^2) / (2 |d|^2), 0, 1)
-/// ```
-///
-/// `r_n`, `r_f` the face radii. For a symmetric perspective slice with half-angle
-/// tangents `t_x`, `t_y` between depths `n` and `f` that is the centre depth
-/// `min(f, (n + f) (1 + t_x^2 + t_y^2) / 2)`. Other slices (an off-centre custom
-/// projection) take the exact minimum of the envelope: the least of its values at
-/// the segment's ends, at each line's own vertex and at each crossing of two lines.
-/// Either way the radius is the distance to the farthest corner, so the sphere
-/// encloses the slice.
-pub(crate) fn bounding_sphere(corners: &[DVec3; 8]) -> (DVec3, f64) {
-    let near_c = (corners[0] + corners[1] + corners[2] + corners[3]) * 0.25;
-    let far_c = (corners[4] + corners[5] + corners[6] + corners[7]) * 0.25;
-    let d = far_c - near_c;
-    let dd = d.length_squared();
-    let farthest = |c: DVec3| {
-        corners
-            .iter()
-            .map(|p| p.distance_squared(c))
-            .fold(0.0, f64::max)
-    };
-    if !(dd > 0.0) {
-        return (near_c, math::sqrt(farthest(near_c)));
-    }
-    let t = match two_face_parameter(corners, near_c, far_c, d, dd) {
-        Some(t) => t,
-        None => envelope_minimum(corners, near_c, d, dd),
-    };
-    let center = near_c + d * t;
-    (center, math::sqrt(farthest(center)))
-}
-
-/// The closed-form parameter of [`bounding_sphere`] when the segment is perpendicular
-/// to both faces and each face's corners are equidistant from its centroid (to a
-/// relative `1e-12`); `None` otherwise.
-fn two_face_parameter(
-    corners: &[DVec3; 8],
-    near_c: DVec3,
-    far_c: DVec3,
-    d: DVec3,
-    dd: f64,
-) -> Option<f64> {
-    const TOL: f64 = 1e-12;
-    let mut r2 = [(f64::INFINITY, 0.0f64); 2];
-    let mut skew = 0.0f64;
-    for (i, p) in corners.iter().enumerate() {
-        let e = *p - if i < 4 { near_c } else { far_c };
-        let e2 = e.length_squared();
-        let r = &mut r2[i / 4];
-        *r = (r.0.min(e2), r.1.max(e2));
-        skew = skew.max(d.dot(e).abs());
-    }
-    let scale = dd.max(r2[0].1).max(r2[1].1);
-    let equidistant = r2.iter().all(|(lo, hi)| hi - lo <= TOL * scale);
-    // |d.e| <= |d| |e| sin(tolerance): compare squares to avoid a root.
-    if !(equidistant && skew * skew <= TOL * TOL * dd * scale) {
-        return None;
-    }
-    Some(((dd + r2[1].1 - r2[0].1) / (2.0 * dd)).clamp(0.0, 1.0))
-}
-
-/// The exact minimizer over `t` in `[0, 1]` of `dd t^2 + max_i (a_i t + b_i)`, the
-/// farthest-corner squared distance along the centroid segment (see
-/// [`bounding_sphere`]).
-fn envelope_minimum(corners: &[DVec3; 8], near_c: DVec3, d: DVec3, dd: f64) -> f64 {
-    let lines: [(f64, f64); 8] = core::array::from_fn(|i| {
-        let e = corners[i] - near_c;
-        (-2.0 * d.dot(e), e.length_squared())
-    });
-    let value = |t: f64| {
-        dd * t * t
-            + lines
-                .iter()
-                .map(|(a, b)| a * t + b)
-                .fold(f64::MIN, f64::max)
-    };
-    let mut best = (value(0.0), 0.0);
-    let mut consider = |t: f64| {
-        if (0.0..=1.0).contains(&t) {
-            let v = value(t);
-            if v < best.0 {
-                best = (v, t);
-            }
-        }
-    };
-    consider(1.0);
-    for (i, (ai, bi)) in lines.iter().enumerate() {
-        consider(-ai / (2.0 * dd));
-        for (aj, bj) in &lines[i + 1..] {
-            if ai != aj {
-                consider((bj - bi) / (ai - aj));
-            }
-        }
-    }
-    best.1
-}
-
-/// The previous bounding-sphere search: an 80-step ternary search along the centroid
-/// segment. Kept as the reference the closed form is tested against.
-#[cfg(test)]
-pub(crate) fn bounding_sphere_search(corners: &[DVec3; 8]) -> (DVec3, f64) {
-    let near_c = (corners[0] + corners[1] + corners[2] + corners[3]) * 0.25;
-    let far_c = (corners[4] + corners[5] + corners[6] + corners[7]) * 0.25;
-    let radius_at = |t: f64| {
-        let c = near_c.lerp(far_c, t);
-        corners
-            .iter()
-            .map(|p| p.distance_squared(c))
-            .fold(0.0, f64::max)
-    };
-    let (mut a, mut b) = (0.0f64, 1.0f64);
-    for _ in 0..80 {
-        let m1 = a + (b - a) / 3.0;
-        let m2 = b - (b - a) / 3.0;
-        if radius_at(m1) <= radius_at(m2) {
-            b = m2;
-        } else {
-            a = m1;
-        }
-    }
-    let t = 0.5 * (a + b);
-    (near_c.lerp(far_c, t), math::sqrt(radius_at(t)))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{bounding_sphere, bounding_sphere_search};
-    use glam::DVec3;
-    use proptest::prelude::*;
-    use shadowmap_testgen::{arbitrary::Unstructured, camera, in_range, strategy};
-
-    /// This crate's camera from the generators' (they link the library build).
-    fn local(c: &shadowmap_testgen::frustum::built::Camera) -> crate::Camera {
-        use crate::Projection as P;
-        use shadowmap_testgen::frustum::built::Projection as Q;
-        let projection = match c.projection {
-            Q::Perspective {
-                fov_y,
-                aspect,
-                near,
-                far,
-            } => P::Perspective {
-                fov_y,
-                aspect,
-                near,
-                far,
-            },
-            Q::InfinitePerspective {
-                fov_y,
-                aspect,
-                near,
-                shadow_distance,
-            } => P::InfinitePerspective {
-                fov_y,
-                aspect,
-                near,
-                shadow_distance,
-            },
-            Q::Orthographic {
-                left,
-                right,
-                bottom,
-                top,
-                near,
-                far,
-            } => P::Orthographic {
-                left,
-                right,
-                bottom,
-                top,
-                near,
-                far,
-            },
-            Q::Custom {
-                clip_from_view,
-                shadow_distance,
-            } => P::Custom {
-                clip_from_view,
-                shadow_distance,
-            },
-        };
-        crate::Camera {
-            world_from_view: c.world_from_view,
-            projection,
-            reversed_z: c.reversed_z,
-        }
-    }
-
-    /// View-space corners of a random slice of a random valid camera (any projection,
-    /// near-degenerate ones included).
-    fn slice_corners(u: &mut Unstructured<'_>) -> shadowmap_testgen::GenResult<[DVec3; 8]> {
-        let camera = local(&camera(u)?);
-        let g = camera
-            .geometry()
-            .map_err(|_| shadowmap_testgen::arbitrary::Error::IncorrectFormat)?;
-        let a = f64::from(in_range(u, 0.0, 1.0)?);
-        let b = f64::from(in_range(u, 0.0, 1.0)?);
-        let (a, b) = (a.min(b), a.max(b).max(a.min(b) + 1e-3).min(1.0));
-        let depth = |t: f64| g.near + (g.far - g.near) * t;
-        let (n, f) = (depth(a), depth(b));
-        if !(f > n) {
-            return Err(shadowmap_testgen::arbitrary::Error::IncorrectFormat);
-        }
-        Ok(g.view_corners(n, f))
-    }
-
-    proptest! {
-        #![proptest_config(shadowmap_testgen::proptest_config())]
-
-        /// The closed form (or the exact envelope minimum) gives the search's sphere:
-        /// the same radius within 1e-6 relative, and it encloses every corner.
-        #[test]
-        fn bounding_sphere_matches_search(corners in strategy(slice_corners)) {
-            let (c, r) = bounding_sphere(&corners);
-            let (c_ref, r_ref) = bounding_sphere_search(&corners);
-            prop_assert!(r.is_finite() && r > 0.0);
-            prop_assert!((r - r_ref).abs() <= 1e-6 * r_ref, "{r} vs {r_ref}");
-            let scale = corners.iter().map(|p| p.length()).fold(r, f64::max);
-            prop_assert!((c - c_ref).length() <= 1e-3 * scale + 1e-6 * scale, "{c} vs {c_ref}");
-            for p in &corners {
-                prop_assert!(p.distance(c) <= r * (1.0 + 1e-12));
-            }
-        }
-    }
-
-    /// The symmetric closed form: centre depth `min(f, (n + f)(1 + tx^2 + ty^2) / 2)`.
-    #[test]
-    fn symmetric_slice_centre_depth() {
-        let (tx, ty) = (0.7f64, 0.4f64);
-        let k = tx * tx + ty * ty;
-        for (n, f) in [(0.1, 10.0), (8.0, 24.7), (50.0, 60.0), (1.0, 1000.0)] {
-            let corner = |d: f64, sx: f64, sy: f64| DVec3::new(sx * tx * d, sy * ty * d, -d);
-            let signs = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
-            let corners: [DVec3; 8] = core::array::from_fn(|i| {
-                let (sx, sy) = signs[i % 4];
-                corner(if i < 4 { n } else { f }, sx, sy)
-            });
-            let (c, r) = bounding_sphere(&corners);
-            let depth = f64::min(f, (n + f) * (1.0 + k) / 2.0);
-            assert!((-c.z - depth).abs() < 1e-9 * f, "{n} {f}: {c}");
-            assert!(c.x.abs() < 1e-12 && c.y.abs() < 1e-12);
-            let expect = ((f - depth).powi(2) + f * f * k).sqrt();
-            assert!((r - expect).abs() < 1e-9 * f, "{r} vs {expect}");
-        }
-    }
 }

@@ -1,4 +1,4 @@
-use crate::{Camera, CascadeSplits, FrustumError, SplitScheme};
+use crate::{Camera, CascadeSplits, FrustumError, SplitScheme, ValidCamera};
 
 /// View-depth bounds of the visible samples, measured by a min/max reduction of the
 /// depth buffer (SDSM, Lauritzen et al. 2011; the truncated view frustum of IPSM).
@@ -23,13 +23,19 @@ impl DepthBounds {
     /// # Errors
     /// Only errors of [`Camera::validate`].
     pub fn clamped_to(&self, camera: &Camera) -> Result<(f32, f32), FrustumError> {
-        let (near, far) = camera.depth_range()?;
+        Ok(self.clamped_to_valid(&ValidCamera::new(camera)?))
+    }
+
+    /// As [`DepthBounds::clamped_to`] for a camera validated once per frame.
+    #[must_use]
+    pub fn clamped_to_valid(&self, camera: &ValidCamera) -> (f32, f32) {
+        let (near, far) = camera.depth_range();
         let (lo, hi) = (self.min.max(near), self.max.min(far));
         let thin = !(hi - lo > 1e-5 * hi.abs().max(lo.abs()));
         if !(lo.is_finite() && hi.is_finite()) || thin {
-            return Ok((near, far));
+            return (near, far);
         }
-        Ok((lo, hi))
+        (lo, hi)
     }
 }
 

@@ -109,19 +109,12 @@ pub(crate) fn dplanes(
     }; 6];
     for (plane, face) in planes.iter_mut().zip(FACES) {
         let quad = face.map(|i| corners[i]);
-        // Newell's normal uses all four corners, so a face with one tiny edge (the near
-        // face of a frustum with a small near distance) is as well conditioned as its
-        // long edges allow; the plane passes through the corners' mean.
-        let mut normal = DVec3::ZERO;
-        for k in 0..4 {
-            let (a, b) = (quad[k], quad[(k + 1) % 4]);
-            normal += DVec3::new(
-                (a.y - b.y) * (a.z + b.z),
-                (a.z - b.z) * (a.x + b.x),
-                (a.x - b.x) * (a.y + b.y),
-            );
-        }
-        let normal = normal
+        // The quad's area vector is half the cross product of its diagonals (Newell's
+        // normal in closed form): it uses all four corners, so a face with one tiny edge
+        // (the near face of a frustum with a small near distance) is as well conditioned
+        // as its long edges allow; the plane passes through the corners' mean.
+        let normal = (quad[2] - quad[0])
+            .cross(quad[3] - quad[1])
             .try_normalize()
             .ok_or(FrustumError::DegenerateFrustum)?;
         let mean = (quad[0] + quad[1] + quad[2] + quad[3]) * 0.25;

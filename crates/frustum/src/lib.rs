@@ -75,6 +75,7 @@
 #![cfg_attr(not(feature = "std"), no_std)]
 
 mod body;
+mod bounding_sphere;
 mod camera;
 mod cascade;
 mod depth_bounds;
@@ -88,6 +89,7 @@ mod predict;
 pub mod projection;
 mod split;
 mod spot;
+mod valid;
 
 pub use body::{ConvexBody, MAX_BODY_VERTICES};
 pub use camera::{Camera, Projection};
@@ -108,5 +110,6 @@ pub use predict::{
 };
 pub use split::{CascadeBlend, CascadeSplits, MAX_CASCADES, SplitScheme};
 pub use spot::{SpotShadow, fit_spot};
+pub use valid::ValidCamera;
 
 pub use glam;

@@ -136,33 +136,29 @@ impl ShadowMapping for ShadowTransform {
 /// row equal to the `w` row for a tiny near plane far from the origin; scaling by the
 /// world's magnitude keeps the test independent of the world's units.
 pub fn is_invertible(m: &Mat4, world_scale: f32) -> bool {
-    if !m.is_finite() {
+    let a = m.to_cols_array();
+    if !a.iter().all(|x| x.is_finite()) {
         return false;
     }
-    let d = m.as_dmat4();
+    let d = a.map(f64::from);
     let s = f64::from(world_scale.abs()).max(f64::MIN_POSITIVE);
-    let rows: [glam::DVec4; 4] = core::array::from_fn(|r| {
-        glam::DVec4::new(
-            d.x_axis[r] * s,
-            d.y_axis[r] * s,
-            d.z_axis[r] * s,
-            d.w_axis[r],
-        )
-    });
+    // Row `r` of the column-major matrix is `d[r], d[4 + r], d[8 + r], d[12 + r]`.
+    let rows: [glam::DVec4; 4] =
+        core::array::from_fn(|r| glam::DVec4::new(d[r] * s, d[4 + r] * s, d[8 + r] * s, d[12 + r]));
+    let norms = rows.map(glam::DVec4::length_squared);
+    if norms.contains(&0.0) {
+        return false;
+    }
     for i in 0..4 {
         for j in i + 1..4 {
-            let (a, b) = (rows[i].length_squared(), rows[j].length_squared());
-            if a == 0.0 || b == 0.0 {
-                return false;
-            }
             let dot = rows[i].dot(rows[j]);
             // sin² of the angle between the rows.
-            if 1.0 - dot * dot / (a * b) < 1e-12 {
+            if 1.0 - dot * dot / (norms[i] * norms[j]) < 1e-12 {
                 return false;
             }
         }
     }
-    let det = d.determinant();
+    let det = DMat4::from_cols_array(&d).determinant();
     det != 0.0 && det.is_finite()
 }
 

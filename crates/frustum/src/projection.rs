@@ -38,6 +38,35 @@ pub fn orthographic(
     )
 }
 
+/// `orthographic(l, r, b, t, near, far, reversed_z) * light_from_affine` for an affine
+/// `light_from_affine` (last row `0, 0, 0, 1`), without the general product: the
+/// orthographic matrix only scales and offsets rows, so each output row is one scaled
+/// row of `light_from_affine` plus an offset (the same values the product gives).
+#[must_use]
+#[allow(clippy::too_many_arguments)] // The orthographic box plus the matrix it applies to.
+pub fn orthographic_times_affine(
+    l: f64,
+    r: f64,
+    b: f64,
+    t: f64,
+    near: f64,
+    far: f64,
+    reversed_z: bool,
+    light_from_affine: &DMat4,
+) -> DMat4 {
+    let (n, f) = if reversed_z { (far, near) } else { (near, far) };
+    let rcp = 1.0 / (n - f);
+    let scale = DVec4::new(2.0 / (r - l), 2.0 / (t - b), rcp, 0.0);
+    let offset = DVec4::new(-(r + l) / (r - l), -(t + b) / (t - b), rcp * n, 1.0);
+    let m = light_from_affine;
+    DMat4::from_cols(
+        m.x_axis * scale,
+        m.y_axis * scale,
+        m.z_axis * scale,
+        m.w_axis * scale + offset,
+    )
+}
+
 /// Off-centre perspective from the tangents of the side planes, between distances
 /// `0 < near < far`.
 #[must_use]

@@ -424,8 +424,13 @@ impl ParaboloidMap {
 /// back: disc = (-q.x, q.y) / (|q| + q.z); uv = 0.5 + (0.5, -0.5) * disc / zoom
 /// depth = (|q| - near) / (far - near), 1 - depth if reversed
 /// ```
+///
+/// Six 16-byte rows with no padding, so `#[repr(C)]` matches WGSL's uniform layout;
+/// with the `bytemuck` feature the block is `Pod` and `Zeroable` and uploads as is
+/// (`bytemuck::bytes_of`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "bytemuck", derive(bytemuck::Pod, bytemuck::Zeroable))]
 pub struct ParaboloidUniform {
     /// `light_from_world` with its translation column cleared, column-major.
     pub rotation: [[f32; 4]; 4],

@@ -1,7 +1,7 @@
 //! The IPSM plan: truncated frustum, light cone, rotation, cut, single or dual.
 
 use glam::{DVec3, Vec3};
-use shadowmap_frustum::{Camera, DepthBounds, Light, ShadowMapping, ShadowSample};
+use shadowmap_frustum::{Camera, DepthBounds, Light, ShadowMapping, ShadowSample, ValidCamera};
 
 use crate::ParaboloidError;
 use crate::cone::{
@@ -182,7 +182,8 @@ impl IpsmPlan {
             } => (position, range),
             Light::Directional { .. } => return Err(ParaboloidError::UnsupportedLight),
         };
-        camera.validate()?;
+        // Checked once; the depth range and the slice below reuse it.
+        let valid = ValidCamera::new_validated(camera)?;
         let (lo, hi) = match bounds {
             Some(b) if b.min.is_nan() || b.max.is_nan() => return Err(ParaboloidError::NonFinite),
             Some(b) if b.min > b.max => {
@@ -191,10 +192,10 @@ impl IpsmPlan {
                     max: b.max,
                 });
             }
-            Some(b) => b.clamped_to(camera)?,
-            None => camera.depth_range()?,
+            Some(b) => b.clamped_to_valid(&valid),
+            None => valid.depth_range(),
         };
-        let frustum = camera.slice(lo, hi)?;
+        let frustum = valid.slice(lo, hi)?;
         let mut plan =
             Self::from_points(position, range, &frustum.corners, camera.forward(), options)?;
         plan.depth_range = (lo, hi);

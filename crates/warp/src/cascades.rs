@@ -2,7 +2,7 @@
 
 use arrayvec::ArrayVec;
 use glam::Vec3;
-use shadowmap_frustum::{Camera, CascadeSplits, MAX_CASCADES};
+use shadowmap_frustum::{Camera, CascadeSplits, MAX_CASCADES, ValidCamera};
 
 use crate::{FocusBody, LispsmOptions, LispsmShadow, SceneBounds, WarpError};
 
@@ -51,11 +51,18 @@ pub fn warped_cascades(
     }
     let mut cascades = ArrayVec::new();
     let mut any = false;
+    // Validated once, at its first use (so errors come in the same order as when
+    // each slice checked the camera).
+    let mut valid: Option<ValidCamera> = None;
     for (i, eta) in etas.iter().enumerate() {
         let (near, far) = splits.cascade_range(i).ok_or(WarpError::InvalidCascades)?;
         let opts = options.with_eta(*eta);
         opts.check()?;
-        let shadow = match FocusBody::slice(camera, near, far, light_direction, scene)
+        let camera = match valid {
+            Some(v) => v,
+            None => *valid.insert(ValidCamera::new(camera)?),
+        };
+        let shadow = match FocusBody::slice_valid(&camera, near, far, light_direction, scene)
             .and_then(|body| body.lispsm(&opts))
         {
             Ok(s) => {

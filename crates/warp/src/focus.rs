@@ -5,7 +5,7 @@ use arrayvec::ArrayVec;
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 use shadowmap_frustum::{
     Aabb, Camera, ConvexBody, Frustum, LightDirection, MAX_BODY_VERTICES, SceneBounds,
-    ShadowTransform, math,
+    ShadowTransform, ValidCamera, math,
 };
 
 use crate::WarpError;
@@ -298,7 +298,20 @@ impl FocusBody {
         light_direction: Vec3,
         scene: &SceneBounds,
     ) -> Result<Self, WarpError> {
-        let view = View::camera(camera)?;
+        Self::new_valid(&ValidCamera::new(camera)?, light_direction, scene)
+    }
+
+    /// As [`FocusBody::new`] for a camera validated once per frame (see
+    /// [`ValidCamera`]): the same body, without checking the camera again.
+    ///
+    /// # Errors
+    /// As [`FocusBody::new`], except the camera's.
+    pub fn new_valid(
+        camera: &ValidCamera,
+        light_direction: Vec3,
+        scene: &SceneBounds,
+    ) -> Result<Self, WarpError> {
+        let view = View::with_frustum(camera.camera(), camera.frustum())?;
         let focus = focus(&view, light_direction, scene)?;
         Ok(Self { view, focus })
     }
@@ -316,7 +329,28 @@ impl FocusBody {
         light_direction: Vec3,
         scene: &SceneBounds,
     ) -> Result<Self, WarpError> {
-        let view = View::with_frustum(camera, camera.slice(near, far)?)?;
+        Self::slice_valid(
+            &ValidCamera::new(camera)?,
+            near,
+            far,
+            light_direction,
+            scene,
+        )
+    }
+
+    /// As [`FocusBody::slice`] for a camera validated once per frame (see
+    /// [`ValidCamera`]).
+    ///
+    /// # Errors
+    /// As [`FocusBody::slice`], except the camera's.
+    pub fn slice_valid(
+        camera: &ValidCamera,
+        near: f32,
+        far: f32,
+        light_direction: Vec3,
+        scene: &SceneBounds,
+    ) -> Result<Self, WarpError> {
+        let view = View::with_frustum(camera.camera(), camera.slice(near, far)?)?;
         let focus = focus(&view, light_direction, scene)?;
         Ok(Self { view, focus })
     }

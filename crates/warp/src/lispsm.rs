@@ -110,7 +110,7 @@ pub struct LispsmShadow {
 /// strength parameter of Lloyd et al. (2006).
 ///
 /// # Errors
-/// As [`uniform_focused`], and [`WarpError::InvalidOption`] for options out of range.
+/// As [`uniform_focused`](crate::uniform_focused), and [`WarpError::InvalidOption`] for options out of range.
 pub fn lispsm(
     camera: &Camera,
     light_direction: Vec3,

@@ -133,9 +133,6 @@ impl XpsmShadow {
 /// Homogeneous post-projective light-space point.
 type Hom = DVec4;
 
-/// Points of a box or body, plus room for clipping intersections.
-type Cloud = ArrayVec<Hom, 1100>;
-
 /// Extended perspective shadow map (Gusev 2007).
 ///
 /// The 18 steps of the paper, in this crate's conventions (column vectors, light
@@ -325,11 +322,9 @@ fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow
     // The points that set maxLengthP land on w = epsilonW itself: classify with a
     // relative margin so rounding cannot drop them.
     let eps_clip = eps_w * (1.0 - 1e-9);
-    let caster_cloud = clip_cloud(&ppls, &casters, eps_clip);
-    let receiver_cloud = clip_cloud(&ppls, &receivers, eps_clip);
     // Step 12: boxes.
-    let cbox = cloud_bounds(&caster_cloud, eps_clip);
-    let rbox = cloud_bounds(&receiver_cloud, eps_clip);
+    let cbox = clipped_bounds(&ppls, &casters, eps_clip);
+    let rbox = clipped_bounds(&ppls, &receivers, eps_clip);
     let (Some((cxy, cz)), Some((rxy, rz))) = (cbox, rbox) else {
         return Err(WarpError::EmptyFocusRegion);
     };
@@ -444,43 +439,57 @@ fn auto_length(f: &Focus, view: &View, weight: f64) -> (f64, f64) {
     (s, y0 - y_eye)
 }
 
-/// PPLS points of a vertex set, split by the plane `w = eps_w`: every vertex (those
-/// behind flagged by `w < eps_w`), plus the crossing of every segment between a
-/// vertex in front and one behind (a superset of the clipped hull's vertices).
-fn clip_cloud(ppls: &DMat4, points: &[DVec3], eps_w: f64) -> Cloud {
-    let mut out = Cloud::new();
+/// The xy box and the z range of the PPLS points of a vertex set split by the plane
+/// `w = eps_w`: every vertex (those behind, `w < eps_w`, with `w` raised to `eps_w`
+/// for the xy box and left out of the z range), plus the crossing of every segment
+/// between a vertex in front and one behind (a superset of the clipped hull's
+/// vertices). `None` when no vertex has `w >= eps_w`. The points are bounded as they
+/// are made, never stored.
+fn clipped_bounds(ppls: &DMat4, points: &[DVec3], eps_w: f64) -> Option<(Bounds, (f64, f64))> {
     let hom: ArrayVec<Hom, 64> = points.iter().map(|p| *ppls * p.extend(1.0)).collect();
+    let mut acc = CloudBounds::EMPTY;
     for h in &hom {
-        let _ = out.try_push(*h);
+        acc.add(*h, eps_w);
     }
     for a in hom.iter().filter(|h| h.w >= eps_w) {
         for b in hom.iter().filter(|h| h.w < eps_w) {
             let t = (a.w - eps_w) / (a.w - b.w);
             let mut c = *a + (*b - *a) * t;
             c.w = eps_w;
-            let _ = out.try_push(c);
+            acc.add(c, eps_w);
         }
     }
-    out
+    acc.finish()
 }
 
-/// The xy box (all points, `w` raised to at least `eps_w`) and the z range (points
-/// with `w >= eps_w` only) of a cloud; `None` when no point has `w >= eps_w`.
-fn cloud_bounds(cloud: &Cloud, eps_w: f64) -> Option<(Bounds, (f64, f64))> {
-    let mut xy = Bounds::EMPTY;
-    let (mut z0, mut z1) = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut any = false;
-    for h in cloud {
+/// Running bounds of [`clipped_bounds`].
+struct CloudBounds {
+    xy: Bounds,
+    z: (f64, f64),
+    any: bool,
+}
+
+impl CloudBounds {
+    const EMPTY: Self = Self {
+        xy: Bounds::EMPTY,
+        z: (f64::INFINITY, f64::NEG_INFINITY),
+        any: false,
+    };
+
+    fn add(&mut self, h: Hom, eps_w: f64) {
         let w = h.w.max(eps_w);
-        xy.add(DVec3::new(h.x / w, h.y / w, 0.0));
+        self.xy.add(DVec3::new(h.x / w, h.y / w, 0.0));
         if h.w >= eps_w {
-            any = true;
-            z0 = z0.min(h.z / h.w);
-            z1 = z1.max(h.z / h.w);
+            self.any = true;
+            self.z = (self.z.0.min(h.z / h.w), self.z.1.max(h.z / h.w));
         }
     }
-    (any && xy.min.is_finite() && xy.max.is_finite() && z0.is_finite() && z1.is_finite())
-        .then_some((xy, (z0, z1)))
+
+    fn finish(self) -> Option<(Bounds, (f64, f64))> {
+        let (xy, (z0, z1)) = (self.xy, self.z);
+        (self.any && xy.min.is_finite() && xy.max.is_finite() && z0.is_finite() && z1.is_finite())
+            .then_some((xy, (z0, z1)))
+    }
 }
 
 #[cfg(test)]

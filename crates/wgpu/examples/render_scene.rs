@@ -1,8 +1,11 @@
 //! Renders the city block with every technique and writes one PNG per technique to
-//! `target/shadowmap-report/rendered/` (linked from the compare report).
+//! `rendered/` of the report directory (`--out`, default `target/shadowmap-report`
+//! relative to the working directory, as for `compare`). The `index.html` that
+//! `compare` writes shows them; `compare` keeps `rendered/` when it replaces the
+//! report.
 //!
 //! ```text
-//! cargo run -p shadowmap-wgpu --example render_scene
+//! cargo run -p shadowmap-wgpu --example render_scene -- [--out DIR]
 //! ```
 
 use std::path::PathBuf;
@@ -21,7 +24,42 @@ use shadowmap_warp::{
 use shadowmap_wgpu::GpuContext;
 use shadowmap_wgpu::render::{HeadlessRenderer, RenderOptions, ShadowFilter, ShadowTechnique};
 
+const USAGE: &str = "usage: render_scene [--out DIR]
+
+Renders the city block with every shadow-map technique into DIR/rendered/<technique>.png
+(default DIR: target/shadowmap-report, the report directory of compare, whose index.html
+shows them).";
+
+/// The report directory: `--out DIR`, or `compare`'s default; `None` for `--help`.
+fn out_dir() -> Result<Option<PathBuf>, String> {
+    let mut args = std::env::args().skip(1);
+    let mut out = PathBuf::from("target/shadowmap-report");
+    while let Some(arg) = args.next() {
+        match arg.as_str() {
+            "--out" => out = args.next().ok_or("--out needs a directory")?.into(),
+            "-h" | "--help" => return Ok(None),
+            other => return Err(format!("unknown argument {other:?}\n\n{USAGE}")),
+        }
+    }
+    Ok(Some(out))
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let dir = match out_dir() {
+        Ok(Some(out)) => out.join("rendered"),
+        Ok(None) => {
+            #[allow(clippy::print_stdout)] // Asked-for help goes to stdout.
+            {
+                println!("{USAGE}");
+            }
+            return Ok(());
+        }
+        Err(message) => {
+            eprintln!("{message}");
+            std::process::exit(2);
+        }
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let ctx = GpuContext::new_headless()?;
     eprintln!("adapter: {}", ctx.describe());
     let scene = Scene::city_block(1);
@@ -87,8 +125,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         warps: &warps,
     };
 
-    let dir =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/shadowmap-report/rendered");
     let mut renderer = HeadlessRenderer::new();
     let jobs: [(&str, ShadowTechnique<'_>, RenderOptions); 8] = [
         ("uniform", ShadowTechnique::Matrix(&uniform), options),

@@ -62,6 +62,20 @@ impl GpuContext {
     /// # Errors
     /// As [`GpuContext::new_headless`].
     pub async fn new_headless_async() -> Result<Self, BackendError> {
+        Self::open(wgpu::Features::empty()).await
+    }
+
+    /// [`GpuContext::new_headless`] with those of `wanted` the adapter offers
+    /// enabled (e.g. [`crate::profile::GpuProfiler::FEATURES`]); check
+    /// `device.features()` for what was granted.
+    ///
+    /// # Errors
+    /// As [`GpuContext::new_headless`].
+    pub fn new_headless_with_features(wanted: wgpu::Features) -> Result<Self, BackendError> {
+        pollster::block_on(Self::open(wanted))
+    }
+
+    async fn open(wanted: wgpu::Features) -> Result<Self, BackendError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = instance
@@ -76,7 +90,7 @@ impl GpuContext {
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("shadowmap"),
-                required_features: wgpu::Features::empty(),
+                required_features: wanted & adapter.features(),
                 required_limits: wgpu::Limits::default().using_resolution(adapter.limits()),
                 ..Default::default()
             })
@@ -96,8 +110,13 @@ impl GpuContext {
     }
 
     /// Maps a `MAP_READ` buffer, waits for it, and hands its bytes to `read`; the
-    /// buffer is unmapped afterwards.
-    pub(crate) fn read_mapped<T>(
+    /// buffer is unmapped afterwards. The one place the backend maps memory: every
+    /// readback ([`GpuContext::read_buffer`], [`GpuContext::read_texture`], a
+    /// persistent staging buffer) ends here.
+    ///
+    /// # Errors
+    /// [`BackendError::Readback`] if mapping fails.
+    pub fn read_mapped<T>(
         &self,
         buffer: &wgpu::Buffer,
         read: impl FnOnce(&[u8]) -> T,
@@ -124,6 +143,97 @@ impl GpuContext {
         Ok(value)
     }
 
+    /// A fresh `MAP_READ | COPY_DST` buffer of `size` bytes.
+    fn staging(&self, size: u64) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadowmap readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// Copies a whole buffer into a fresh staging buffer, waits for the GPU and
+    /// returns its bytes (a test, debug and report path: it allocates and blocks).
+    ///
+    /// # Errors
+    /// [`BackendError::InvalidInput`] for a buffer without `COPY_SRC` usage;
+    /// [`BackendError::Readback`] if mapping fails.
+    pub fn read_buffer(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>, BackendError> {
+        if !buffer.usage().contains(wgpu::BufferUsages::COPY_SRC) {
+            return Err(BackendError::InvalidInput("buffer lacks COPY_SRC"));
+        }
+        let staging = self.staging(buffer.size());
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("shadowmap readback"),
+            });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+        self.queue.submit([encoder.finish()]);
+        self.read_mapped(&staging, <[u8]>::to_vec)
+    }
+
+    /// Copies mip 0 of every layer of a texture (one `aspect`) into a fresh staging
+    /// buffer, waits for the GPU and returns the texels tightly packed: layer-major,
+    /// then row-major, row 0 at the top.
+    ///
+    /// # Errors
+    /// [`BackendError::InvalidInput`] for a texture without `COPY_SRC` usage or an
+    /// aspect or format that cannot be copied texel by texel (compressed, or both
+    /// aspects of depth-stencil); [`BackendError::Readback`] if mapping fails.
+    pub fn read_texture(
+        &self,
+        texture: &wgpu::Texture,
+        aspect: wgpu::TextureAspect,
+    ) -> Result<Vec<u8>, BackendError> {
+        if !texture.usage().contains(wgpu::TextureUsages::COPY_SRC) {
+            return Err(BackendError::InvalidInput("texture lacks COPY_SRC"));
+        }
+        let format = texture.format();
+        let texel = format
+            .block_copy_size(Some(aspect))
+            .filter(|_| format.block_dimensions() == (1, 1))
+            .ok_or(BackendError::InvalidInput(
+                "texture aspect cannot be read back",
+            ))?;
+        let (width, height) = (texture.width(), texture.height());
+        let layers = texture.depth_or_array_layers();
+        let row = width * texel;
+        let padded = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        let staging = self.staging(u64::from(padded) * u64::from(height) * u64::from(layers));
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("shadowmap readback"),
+            });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &staging,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(height),
+                },
+            },
+            texture.size(),
+        );
+        self.queue.submit([encoder.finish()]);
+        self.read_mapped(&staging, |mapped| {
+            let mut out = Vec::with_capacity(row as usize * height as usize * layers as usize);
+            for chunk in mapped.chunks(padded as usize) {
+                out.extend_from_slice(&chunk[..row as usize]);
+            }
+            out
+        })
+    }
+
     /// Reads every layer of a `Depth32Float` texture (mip 0) back: layer-major, then
     /// row-major, row 0 at the top. Waits for the GPU.
     ///
@@ -134,18 +244,7 @@ impl GpuContext {
         if texture.format() != wgpu::TextureFormat::Depth32Float {
             return Err(BackendError::InvalidInput("not a Depth32Float texture"));
         }
-        if !texture.usage().contains(wgpu::TextureUsages::COPY_SRC) {
-            return Err(BackendError::InvalidInput("depth texture lacks COPY_SRC"));
-        }
-        let bytes = crate::depth::read_texture(
-            self,
-            texture,
-            wgpu::TextureAspect::DepthOnly,
-            texture.width(),
-            texture.height(),
-            texture.depth_or_array_layers(),
-            4,
-        )?;
+        let bytes = self.read_texture(texture, wgpu::TextureAspect::DepthOnly)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 

@@ -38,7 +38,7 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use crate::uniforms::{MatrixShadowRaw, ParaboloidLayerRaw, RtwShadowRaw};
-use crate::{BackendError, GpuContext, shaders};
+use crate::{BackendError, GpuContext, compose, shaders};
 
 /// The caster subdivision of RTW's depth pass lives beside the warp tables in
 /// `shadowmap-rtw` (one algorithm for the CPU reference and this backend).
@@ -317,40 +317,25 @@ impl ShadowDepthPass {
         if !(desc.bias.slope_scale.is_finite() && desc.bias.clamp.is_finite()) {
             return Err(BackendError::InvalidInput("non-finite depth bias"));
         }
-        ctx.scoped(|ctx| Ok(Self::create(ctx, desc)))
+        ctx.scoped(|ctx| Self::create(ctx, desc))
     }
 
-    fn create(ctx: &GpuContext, desc: &DepthPassDesc) -> Self {
+    fn create(ctx: &GpuContext, desc: &DepthPassDesc) -> Result<Self, BackendError> {
         let device = &ctx.device;
         let align = u64::from(device.limits().min_uniform_buffer_offset_alignment.max(1));
         let slot = BLOCK_BYTES.div_ceil(align) * align;
-        let (source, label, block, fragment) = match desc.technique {
-            DepthTechnique::Matrix => (
-                shaders::DEPTH_MATRIX,
-                "shadowmap depth matrix",
-                size_of::<MatrixShadowRaw>(),
-                false,
-            ),
-            DepthTechnique::Paraboloid => (
-                shaders::DEPTH_PARABOLOID,
-                "shadowmap depth paraboloid",
-                size_of::<ParaboloidLayerRaw>(),
-                true,
-            ),
-            DepthTechnique::Rtw => (
-                shaders::DEPTH_RTW,
-                "shadowmap depth rtw",
-                size_of::<RtwShadowRaw>(),
-                false,
-            ),
-        };
+        let block = match desc.technique {
+            DepthTechnique::Matrix => size_of::<MatrixShadowRaw>(),
+            DepthTechnique::Paraboloid => size_of::<ParaboloidLayerRaw>(),
+            DepthTechnique::Rtw => size_of::<RtwShadowRaw>(),
+        } as u64;
         let mut entries = vec![wgpu::BindGroupLayoutEntry {
             binding: 0,
             visibility: wgpu::ShaderStages::VERTEX,
             ty: wgpu::BindingType::Buffer {
                 ty: wgpu::BufferBindingType::Uniform,
                 has_dynamic_offset: true,
-                min_binding_size: NonZeroU64::new(block as u64),
+                min_binding_size: NonZeroU64::new(block),
             },
             count: None,
         }];
@@ -358,57 +343,10 @@ impl ShadowDepthPass {
             entries.push(storage_entry(1, wgpu::ShaderStages::VERTEX));
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(label),
+            label: Some("shadowmap depth"),
             entries: &entries,
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(label),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(label),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(MeshBuffers::layout())],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(if desc.reversed_z {
-                    wgpu::CompareFunction::Greater
-                } else {
-                    wgpu::CompareFunction::Less
-                }),
-                stencil: Default::default(),
-                bias: wgpu::DepthBiasState {
-                    constant: desc.bias.constant,
-                    slope_scale: desc.bias.slope_scale,
-                    clamp: desc.bias.clamp,
-                },
-            }),
-            multisample: Default::default(),
-            fragment: fragment.then(|| wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = create_pipeline(device, desc, &layout)?;
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("shadowmap depth uniforms"),
             size: slot * u64::from(desc.layers),
@@ -416,7 +354,7 @@ impl ShadowDepthPass {
             mapped_at_creation: false,
         });
         let tables = (desc.technique == DepthTechnique::Rtw).then(|| table_buffer(device, 1));
-        let bind_group = make_bind_group(device, &layout, &uniforms, block as u64, tables.as_ref());
+        let bind_group = make_bind_group(device, &layout, &uniforms, block, tables.as_ref());
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadowmap depth"),
             size: wgpu::Extent3d {
@@ -449,7 +387,7 @@ impl ShadowDepthPass {
                 })
             })
             .collect();
-        Self {
+        Ok(Self {
             desc: *desc,
             pipeline,
             layout,
@@ -460,7 +398,7 @@ impl ShadowDepthPass {
             texture,
             array_view,
             layer_views,
-        }
+        })
     }
 
     /// What the pass was built with.
@@ -617,6 +555,85 @@ fn rtw_table_texels(raw: &RtwShadowRaw) -> usize {
     (raw.sizes[0] as usize).saturating_add(raw.sizes[1] as usize)
 }
 
+/// The depth pipeline of a pass: the technique's vertex shader (RTW's with its table
+/// sampler composed in), a fragment stage only where the paraboloid clips, the
+/// depth test and rasterizer bias of `desc`.
+fn create_pipeline(
+    device: &wgpu::Device,
+    desc: &DepthPassDesc,
+    layout: &wgpu::BindGroupLayout,
+) -> Result<wgpu::RenderPipeline, BackendError> {
+    let (source, label, fragment) = match desc.technique {
+        DepthTechnique::Matrix => (
+            shaders::DEPTH_MATRIX.to_owned(),
+            "shadowmap depth matrix",
+            false,
+        ),
+        DepthTechnique::Paraboloid => (
+            shaders::DEPTH_PARABOLOID.to_owned(),
+            "shadowmap depth paraboloid",
+            true,
+        ),
+        DepthTechnique::Rtw => (compose::depth_rtw()?, "shadowmap depth rtw", false),
+    };
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    Ok(
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(MeshBuffers::layout())],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(depth_state(desc.reversed_z, desc.bias)),
+            multisample: Default::default(),
+            fragment: fragment.then(|| wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        }),
+    )
+}
+
+/// A [`DEPTH_FORMAT`] attachment that keeps the nearer depth (`Less`, or `Greater`
+/// with reversed-Z) and writes it with this rasterizer bias.
+pub(crate) fn depth_state(reversed_z: bool, bias: DepthBias) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(if reversed_z {
+            wgpu::CompareFunction::Greater
+        } else {
+            wgpu::CompareFunction::Less
+        }),
+        stencil: Default::default(),
+        bias: wgpu::DepthBiasState {
+            constant: bias.constant,
+            slope_scale: bias.slope_scale,
+            clamp: bias.clamp,
+        },
+    }
+}
+
 fn storage_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
@@ -664,61 +681,5 @@ fn make_bind_group(
         label: Some("shadowmap depth bind group"),
         layout,
         entries: &entries,
-    })
-}
-
-/// Copies `layers` layers of a texture into tightly packed rows (layer-major) and
-/// waits for them.
-pub(crate) fn read_texture(
-    ctx: &GpuContext,
-    texture: &wgpu::Texture,
-    aspect: wgpu::TextureAspect,
-    width: u32,
-    height: u32,
-    layers: u32,
-    texel_bytes: u32,
-) -> Result<Vec<u8>, BackendError> {
-    let row = width * texel_bytes;
-    let padded = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
-    let size = u64::from(padded) * u64::from(height) * u64::from(layers);
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("shadowmap readback"),
-        size,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder = ctx
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("shadowmap readback"),
-        });
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(height),
-            },
-        },
-        wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: layers,
-        },
-    );
-    ctx.queue.submit([encoder.finish()]);
-    ctx.read_mapped(&buffer, |mapped| {
-        let mut out = Vec::with_capacity((row * height * layers) as usize);
-        for chunk in mapped.chunks(padded as usize) {
-            out.extend_from_slice(&chunk[..row as usize]);
-        }
-        out
     })
 }

@@ -10,10 +10,12 @@
 //!
 //! | module | what |
 //! |---|---|
-//! | [`context`] | [`GpuContext`]: headless device, error scopes ([`GpuContext::scoped`]), test gating |
+//! | [`context`] | [`GpuContext`]: headless device, error scopes ([`GpuContext::scoped`]), readback ([`GpuContext::read_buffer`], [`GpuContext::read_texture`]), test gating |
+//! | [`compose`] | WGSL composition: lookups and filters into the scene shader, the RTW table sampler into its depth pass and lookup |
 //! | [`uniforms`] | `#[repr(C)]` blocks built by [`uniforms::ToRaw`] |
 //! | [`depth`] | [`depth::ShadowDepthPass`]: matrix / paraboloid / RTW depth passes, caster subdivision for RTW |
 //! | [`render`] | [`render::HeadlessRenderer`]: scene pass with a lookup and a filter composed in, PNGs, shadow masks |
+//! | [`profile`] | [`profile::GpuProfiler`]: GPU time per pass from timestamp queries |
 //! | [`reduce`] | depth min/max reduction (SDSM, IPSM depth bounds) |
 //! | [`rtw`] | [`rtw::GpuRtw`]: importance, blur, warp tables on the GPU |
 //! | [`shaders`] | every WGSL source, embedded |
@@ -108,7 +110,15 @@
 //!
 //! # GPU timings
 //!
-//! None were recorded: no hardware GPU was lent to this task. `cargo bench -p
+//! [`profile::GpuProfiler`] times passes on the GPU with timestamp queries, and
+//! [`render::HeadlessRenderer::render_profiled`] records the depth, VSM and scene
+//! passes of a frame with it. `cargo run --release -p shadowmap-wgpu --example
+//! gpu_frame [-- --json]` renders the city block at 1920x1080 with a 2048² budget per
+//! technique and prints the fit's CPU time, the render call's wall time and each
+//! pass's GPU time. No hardware GPU table is recorded here: none was lent to this
+//! task, and llvmpipe's timestamps measure CPU rasterization, not a GPU.
+//!
+//! Hardware GPU figures of the benches were not recorded either. `cargo bench -p
 //! shadowmap-wgpu --bench frame` and `--bench compute` measure the CPU side (uniform
 //! packing, command encoding, caster subdivision) and, where an adapter opens, GPU
 //! round trips; on this machine the adapter is llvmpipe, so any GPU-side figure is
@@ -128,11 +138,13 @@
 //! encode/rtw_depth_pass_256_cell_tables            23 us
 //! ```
 
+pub mod compose;
 pub mod context;
 pub use context::{BackendError, GpuContext};
 
 // --- depth passes, uniforms, lookup, headless renderer (one author) ---
 pub mod depth;
+pub mod profile;
 pub mod render;
 pub mod shadow;
 pub mod uniforms;
@@ -151,7 +163,8 @@ pub mod shaders {
     pub const DEPTH_MATRIX: &str = include_str!("../shaders/depth_matrix.wgsl");
     /// Depth pass of a paraboloid map (one side per layer, hemisphere clipped).
     pub const DEPTH_PARABOLOID: &str = include_str!("../shaders/depth_paraboloid.wgsl");
-    /// Depth pass of RTW (base projection, then the warp tables per axis).
+    /// Depth pass of RTW (base projection, then the warp tables per axis); its
+    /// table sampler is a placeholder until composed ([`crate::compose::depth_rtw`]).
     pub const DEPTH_RTW: &str = include_str!("../shaders/depth_rtw.wgsl");
     /// Lookup of a matrix technique (uniform, LiSPSM, XPSM with its Z bias, TSM).
     pub const LOOKUP_MATRIX: &str = include_str!("../shaders/lookup_matrix.wgsl");
@@ -159,8 +172,11 @@ pub mod shaders {
     pub const LOOKUP_CASCADES: &str = include_str!("../shaders/lookup_cascades.wgsl");
     /// Lookup of a paraboloid map (front/back side, cut).
     pub const LOOKUP_PARABOLOID: &str = include_str!("../shaders/lookup_paraboloid.wgsl");
-    /// Lookup of RTW (base projection, warp tables).
+    /// Lookup of RTW (base projection, warp tables); its table sampler is a
+    /// placeholder until composed ([`crate::compose::lookup_rtw`]).
     pub const LOOKUP_RTW: &str = include_str!("../shaders/lookup_rtw.wgsl");
+    /// The RTW warp-table sampler, composed into the RTW depth pass and lookup.
+    pub const RTW_SAMPLE: &str = include_str!("../shaders/rtw_sample.wgsl");
     /// Filter: one nearest texel.
     pub const FILTER_HARD: &str = include_str!("../shaders/filter_hard.wgsl");
     /// Filter: the hardware 2x2 compare.

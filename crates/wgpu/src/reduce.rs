@@ -308,7 +308,7 @@ impl DepthReduction {
     /// # Errors
     /// [`BackendError::Readback`] when mapping fails.
     pub fn read(&self, ctx: &GpuContext) -> Result<Option<RawDepthRange>, BackendError> {
-        let words = read_buffer(ctx, &self.readback)?;
+        let words: Vec<u32> = ctx.read_mapped(&self.readback, bytemuck::pod_collect_to_vec)?;
         let (lo, hi) = match words.as_slice() {
             [lo, hi, ..] => (*lo, *hi),
             _ => return Err(BackendError::Readback("short result".into())),
@@ -330,14 +330,6 @@ fn partials_buffer(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
         usage: wgpu::BufferUsages::STORAGE,
         mapped_at_creation: false,
     })
-}
-
-/// Maps a `MAP_READ` buffer, blocking, and copies it out as `u32` words.
-pub(crate) fn read_buffer(
-    ctx: &GpuContext,
-    buffer: &wgpu::Buffer,
-) -> Result<Vec<u32>, BackendError> {
-    ctx.read_mapped(buffer, bytemuck::pod_collect_to_vec::<u8, u32>)
 }
 
 #[cfg(test)]

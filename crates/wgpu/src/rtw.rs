@@ -63,7 +63,6 @@ use shadowmap_rtw::{
     EyeSample, ImportanceOptions, MAX_BLUR_RADIUS, MAX_MAP_CELLS, MAX_MAP_SIDE, WarpOptions,
 };
 
-use crate::reduce::read_buffer;
 use crate::{BackendError, GpuContext};
 
 /// Format of both G-buffer textures.
@@ -628,22 +627,9 @@ fn f32_words(words: &[u32]) -> Vec<f32> {
     words.iter().map(|&w| f32::from_bits(w)).collect()
 }
 
-/// Copies a whole `COPY_SRC` buffer into a fresh staging buffer and reads it.
+/// A whole `COPY_SRC` buffer as `u32` words ([`GpuContext::read_buffer`]).
 fn read_copy(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u32>, BackendError> {
-    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("rtw readback"),
-        size: buffer.size(),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = ctx
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("rtw readback"),
-        });
-    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
-    ctx.queue.submit([encoder.finish()]);
-    read_buffer(ctx, &staging)
+    Ok(bytemuck::pod_collect_to_vec(&ctx.read_buffer(buffer)?))
 }
 
 #[cfg(test)]

@@ -35,7 +35,7 @@ impl HeadlessRenderer {
     ///
     /// # Errors
     /// As [`HeadlessRenderer::render`]; [`BackendError::InvalidInput`] for a result
-    /// the backend has no pass for yet (warped cascades).
+    /// the backend has no pass for.
     pub fn render_shadow(
         &mut self,
         ctx: &GpuContext,
@@ -56,8 +56,8 @@ impl HeadlessRenderer {
 /// view of its tables lives for the call).
 ///
 /// # Errors
-/// [`BackendError::InvalidInput`] for a result the backend has no pass for yet
-/// (warped cascades).
+/// [`BackendError::InvalidInput`] for a result the backend has no pass for (a
+/// `Fitted` variant added after this backend).
 pub fn with_technique<R>(
     shadow: &Shadow,
     f: impl FnOnce(&ShadowTechnique<'_>) -> R,
@@ -73,9 +73,7 @@ pub fn with_technique<R>(
         (Fitted::Cascades(set), _) => ShadowTechnique::Cascades(set),
         (Fitted::Dpsm(map), _) => ShadowTechnique::Paraboloid(map),
         (Fitted::Ipsm(plan), _) => ShadowTechnique::Paraboloid(&plan.map),
-        // MERGE: map to `ShadowTechnique::WarpedCascades(cascades)` once the renderer
-        // has that variant.
-        (Fitted::WarpedCascades { .. }, _) => return Err(UNSUPPORTED),
+        (Fitted::WarpedCascades { cascades, .. }, _) => ShadowTechnique::WarpedCascades(cascades),
         _ => return Err(UNSUPPORTED),
     };
     Ok(f(&technique))

@@ -24,9 +24,9 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
 use shadowmap_frustum::{CascadeSet, LightDirection, MAX_CASCADES, ShadowTransform};
-use shadowmap_paraboloid::{ParaboloidMap, Side};
+use shadowmap_paraboloid::{ParaboloidMap, ParaboloidUniform, Side};
 use shadowmap_rtw::RtwShadow;
-use shadowmap_warp::{LispsmShadow, TsmShadow, XpsmShadow};
+use shadowmap_warp::{LispsmShadow, TsmShadow, WarpedCascades, XpsmShadow};
 
 /// Converts a math-crate result into the uniform block its shaders read.
 pub trait ToRaw {
@@ -165,28 +165,69 @@ pub fn cascade_layers(set: &CascadeSet) -> Vec<MatrixShadowRaw> {
     set.cascades.iter().map(|c| c.transform.to_raw()).collect()
 }
 
-/// A paraboloid map: WGSL `Paraboloid`, the fields of
-/// [`shadowmap_paraboloid::ParaboloidUniform`] (made `Pod`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct ParaboloidRaw {
-    /// `light_from_world` with its translation cleared, column-major.
-    pub rotation: [[f32; 4]; 4],
-    /// Light position (xyz) and near distance (w).
-    pub position_near: [f32; 4],
-    /// Far distance, zoom, reversed-Z (0 or 1), dual (0 or 1).
-    pub far_zoom_reversed_dual: [f32; 4],
+/// A depth-pass `clip_from_world` that sends every vertex to `(0, 0, -1, 1)`,
+/// outside the clip volume: the layer of a warped cascade without a fit stays clear.
+const CLIP_ALL: [[f32; 4]; 4] = [[0.0; 4], [0.0; 4], [0.0; 4], [0.0, 0.0, -1.0, 1.0]];
+
+/// The per-layer depth-pass blocks of warped cascades: one [`MatrixShadowRaw`] per
+/// cascade (layer `i` = cascade `i`) with its LiSPSM matrices; a cascade without a
+/// fit draws nothing (its `clip_from_world` clips every vertex).
+#[must_use]
+pub fn warped_cascade_layers(set: &WarpedCascades) -> Vec<MatrixShadowRaw> {
+    set.cascades
+        .iter()
+        .map(|c| {
+            c.shadow.map_or(
+                MatrixShadowRaw {
+                    clip_from_world: CLIP_ALL,
+                    ..MatrixShadowRaw::zeroed()
+                },
+                |s| s.to_raw(),
+            )
+        })
+        .collect()
 }
 
-impl ToRaw for ParaboloidMap {
-    type Raw = ParaboloidRaw;
-    fn to_raw(&self) -> ParaboloidRaw {
-        let u = ParaboloidMap::to_raw(self);
-        ParaboloidRaw {
-            rotation: u.rotation,
-            position_near: u.position_near,
-            far_zoom_reversed_dual: u.far_zoom_reversed_dual,
+impl CascadeShadowRaw {
+    /// The cascades lookup for warped cascades (`shadowmap_warp::warped_cascades`)
+    /// seen by a camera with this `view_from_world`: cascade `i` is selected by view
+    /// depth up to its `far`, blends toward `i + 1` across the band they share
+    /// (`far_i - near_(i+1)`), and its perspective `uv_from_world` is divided by `w`
+    /// in the lookup. A cascade without a fit keeps a zero matrix (`w = 0`: the
+    /// lookup reports the point as not covered).
+    #[must_use]
+    pub fn from_warped(set: &WarpedCascades, view_from_world: Mat4) -> Self {
+        let mut raw = Self::zeroed();
+        for (i, c) in set.cascades.iter().enumerate().take(MAX_CASCADES) {
+            if let Some(s) = &c.shadow {
+                raw.uv_from_world[i] = cols(&s.transform.uv_from_world);
+            }
+            raw.split_far[i / 4][i % 4] = c.far;
+            let band = set
+                .cascades
+                .get(i + 1)
+                .map_or(0.0, |next| c.far - next.near);
+            raw.band_width[i / 4][i % 4] = if band > 0.0 { band } else { 0.0 };
         }
+        raw.view_z_row = view_from_world.row(2).to_array();
+        raw.count = set.cascades.len().min(MAX_CASCADES) as u32;
+        raw.reversed_z = u32::from(
+            set.cascades
+                .iter()
+                .find_map(|c| c.shadow.as_ref())
+                .is_some_and(|s| s.transform.reversed_z),
+        );
+        raw
+    }
+}
+
+/// A paraboloid map: WGSL `Paraboloid` is
+/// [`shadowmap_paraboloid::ParaboloidUniform`] itself (`Pod` through that crate's
+/// `bytemuck` feature), built by [`ParaboloidMap::to_raw`].
+impl ToRaw for ParaboloidMap {
+    type Raw = ParaboloidUniform;
+    fn to_raw(&self) -> ParaboloidUniform {
+        ParaboloidMap::to_raw(self)
     }
 }
 
@@ -195,7 +236,7 @@ impl ToRaw for ParaboloidMap {
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct ParaboloidLayerRaw {
     /// The map.
-    pub map: ParaboloidRaw,
+    pub map: ParaboloidUniform,
     /// `x`: the side rendered, 0 front, 1 back; `y`: 0 from
     /// [`ParaboloidLayerRaw::new`], the depth pass writes its map resolution there
     /// (the vertex shader snaps to its subpixel grid); `z`, `w`: 0.

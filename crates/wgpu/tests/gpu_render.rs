@@ -424,8 +424,18 @@ fn bad_render_input_is_a_typed_error() {
     })
     .unwrap();
     assert!(direct.is_err());
-    // Warped cascades have no pass yet: a typed error, not a panic.
-    let warped = fit_test(
+}
+
+#[test]
+fn warped_cascade_mask_through_fit_matches_the_cpu_reference() {
+    let Some(ctx) = shadowmap_wgpu::context::test_context(
+        "warped_cascade_mask_through_fit_matches_the_cpu_reference",
+    ) else {
+        return;
+    };
+    let mut renderer = HeadlessRenderer::new();
+    let tris = scene();
+    let shadow = fit_test(
         &Technique::WarpedCascades {
             plan: CascadePlan::default().with_max_cascades(2),
             lispsm: Default::default(),
@@ -434,8 +444,19 @@ fn bad_render_input_is_a_typed_error() {
         2,
         &[],
     );
-    assert!(matches!(
-        renderer.render_shadow(&ctx, &scene(), &camera(), &warped, &options()),
-        Err(shadowmap_wgpu::BackendError::InvalidInput(_))
-    ));
+    let shadowmap::Fitted::WarpedCascades { cascades, .. } = shadow.fitted() else {
+        panic!("warped cascades expected");
+    };
+    let matrices = cascades
+        .cascades
+        .iter()
+        .map(|c| c.shadow.unwrap().transform.clip_from_world.as_dmat4())
+        .collect();
+    let gpu = render(&ctx, &mut renderer, &shadow, &options());
+    let cpu = cpu_mask(
+        &tris,
+        &shadow,
+        &cpu_depth(&tris, &MatrixProjector::new(matrices, false)),
+    );
+    assert_masks_agree("warped cascades", &gpu, &cpu);
 }

@@ -78,14 +78,15 @@ fn validate(name: &str, source: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// Sources composed by concatenation at runtime (WGSL has no includes): every scene
-/// shader (lookup + filter) of the renderer, each with its composition result.
+/// Sources composed at runtime (WGSL has no includes): every scene shader (lookup +
+/// filter) of the renderer and RTW's depth pass (with the shared table sampler),
+/// each with its composition result.
 fn composed_sources() -> Vec<(&'static str, Result<String, shadowmap_wgpu::BackendError>)> {
     shadowmap_wgpu::render::composed_shaders()
 }
 
-/// Lookups times filters the renderer composes.
-const COMPOSITIONS: usize = 4 * 5;
+/// Lookups times filters the renderer composes, and RTW's depth pass.
+const COMPOSITIONS: usize = 4 * 5 + 1;
 
 #[test]
 fn every_shader_file_parses_and_validates() {
@@ -131,7 +132,7 @@ fn composed_sources_parse_and_validate() {
     assert_eq!(
         composed.len(),
         COMPOSITIONS,
-        "every lookup with every filter"
+        "every lookup with every filter, and RTW's depth pass"
     );
     let errors: Vec<String> = composed
         .iter()

@@ -8,11 +8,11 @@ use shadowmap_frustum::{
     Camera, CascadeOptions, CascadeSet, CascadeSplits, LightDirection, Projection, ShadowTransform,
     SplitScheme,
 };
-use shadowmap_paraboloid::{MapOptions, ParaboloidMap};
+use shadowmap_paraboloid::{MapOptions, ParaboloidMap, ParaboloidUniform};
 use shadowmap_wgpu::shaders;
 use shadowmap_wgpu::uniforms::{
-    CascadeShadowRaw, FrameRaw, MatrixShadowRaw, ParaboloidLayerRaw, ParaboloidRaw, RtwShadowRaw,
-    ToRaw, cascade_layers, paraboloid_layers,
+    CascadeShadowRaw, FrameRaw, MatrixShadowRaw, ParaboloidLayerRaw, RtwShadowRaw, ToRaw,
+    cascade_layers, paraboloid_layers, warped_cascade_layers,
 };
 
 /// (struct span, member offsets) of `name` in `source`, by naga's layouter.
@@ -92,18 +92,21 @@ fn cascade_block_matches() {
 #[test]
 fn paraboloid_blocks_match() {
     let map_offsets = [
-        ("rotation", offset_of!(ParaboloidRaw, rotation)),
-        ("position_near", offset_of!(ParaboloidRaw, position_near)),
+        ("rotation", offset_of!(ParaboloidUniform, rotation)),
+        (
+            "position_near",
+            offset_of!(ParaboloidUniform, position_near),
+        ),
         (
             "far_zoom_reversed_dual",
-            offset_of!(ParaboloidRaw, far_zoom_reversed_dual),
+            offset_of!(ParaboloidUniform, far_zoom_reversed_dual),
         ),
     ];
     for source in [shaders::DEPTH_PARABOLOID, shaders::LOOKUP_PARABOLOID] {
         check(
             source,
             "Paraboloid",
-            size_of::<ParaboloidRaw>(),
+            size_of::<ParaboloidUniform>(),
             &map_offsets,
         );
     }
@@ -217,5 +220,60 @@ fn to_raw_copies_the_math_crates_outputs() {
     assert_eq!(
         FrameRaw::light_vector(LightDirection::Position(Vec3::new(4.0, 5.0, 6.0))),
         [4.0, 5.0, 6.0, 1.0]
+    );
+}
+
+#[test]
+fn warped_cascade_blocks_carry_the_fits_bands_and_view_depth() {
+    let camera = Camera::look_at(
+        Vec3::new(0.0, 10.0, 30.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        Projection::perspective(1.0, 1.5, 0.5, 200.0),
+    )
+    .unwrap();
+    let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.7 }, 3, 0.5, 200.0)
+        .unwrap()
+        .with_overlap(0.2)
+        .unwrap();
+    let scene = shadowmap_warp::SceneBounds::whole(shadowmap_frustum::Aabb::new(
+        Vec3::new(-100.0, 0.0, -100.0),
+        Vec3::new(100.0, 20.0, 100.0),
+    ));
+    let light = Vec3::new(-0.7, -0.7, 0.2);
+    let options = shadowmap_warp::LispsmOptions::default().with_reversed_z(true);
+    let mut set =
+        shadowmap_warp::warped_cascades(&camera, light, &scene, &splits, &[0.0; 3], &options)
+            .unwrap();
+    let view = camera.view_from_world().unwrap();
+    let raw = CascadeShadowRaw::from_warped(&set, view);
+    assert_eq!(
+        (raw.count, raw.reversed_z, raw.select_by_projection),
+        (3, 1, 0)
+    );
+    for (i, c) in set.cascades.iter().enumerate() {
+        assert_eq!(raw.split_far[i / 4][i % 4], c.far);
+        let expected = set.cascades.get(i + 1).map_or(0.0, |n| c.far - n.near);
+        assert!((raw.band_width[i / 4][i % 4] - expected).abs() < 1e-6);
+        let uv = c.shadow.unwrap().transform.uv_from_world.to_cols_array_2d();
+        assert_eq!(raw.uv_from_world[i], uv);
+    }
+    assert!(raw.band_width[0][0] > 0.0, "overlapping splits blend");
+    let p = Vec3::new(2.0, 1.0, -30.0);
+    let row = glam::Vec4::from_array(raw.view_z_row);
+    assert!((-row.dot(p.extend(1.0)) - camera.view_depth(p)).abs() < 1e-4);
+
+    // A cascade without a fit: a zero lookup matrix (w = 0, not covered) and a depth
+    // block that puts every vertex outside the clip volume.
+    set.cascades[1].shadow = None;
+    let raw = CascadeShadowRaw::from_warped(&set, view);
+    assert_eq!(raw.uv_from_world[1], [[0.0; 4]; 4]);
+    let layers = warped_cascade_layers(&set);
+    assert_eq!(layers.len(), 3);
+    let clip = Mat4::from_cols_array_2d(&layers[1].clip_from_world) * p.extend(1.0);
+    assert!(clip.z < 0.0 && clip.w > 0.0, "{clip}");
+    assert_eq!(
+        layers[0],
+        set.cascades[0].shadow.unwrap().transform.to_raw()
     );
 }

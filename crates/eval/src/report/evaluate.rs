@@ -17,6 +17,8 @@ use crate::raster::{DepthMap, RasterOptions};
 use crate::technique::{FrameContext, Technique, TechniqueKind, TechniqueOptions, eye_samples};
 
 use super::image::{heatmap_image, mask_image, write_png};
+use super::plots::{DepthPlot, DepthProfile, depth_plot_svg};
+use super::runner::write_file;
 use super::{ConfigSummary, Row, RowMetrics, Settings};
 
 /// Depth bias of the reference depth pass: slope-scaled, so that a receiver's
@@ -89,12 +91,15 @@ pub(super) fn evaluate_config(
     };
     let mut rows = Vec::new();
     let mut files = Vec::new();
+    let mut profiles = Vec::new();
     for kind in TechniqueKind::for_light(&config.light) {
+        bar.set_message(format!("{}: {}", config.name, kind.name()));
         let outcome = match measure(kind, config, &reference, &setup) {
             Ok(measured) => {
                 if let Some(out) = pictures {
                     let base = format!("{}_{}", config.name, kind.name());
                     files.extend(write_pictures(out, &base, &reference, &measured, settings)?);
+                    profiles.push(depth_profile(kind, &reference, &measured.m));
                 }
                 Ok(measured.metrics)
             }
@@ -107,6 +112,9 @@ pub(super) fn evaluate_config(
             outcome,
         });
         bar.inc(1);
+    }
+    if let Some(out) = pictures {
+        files.push(write_depth_plot(out, &summary, &profiles, settings)?);
     }
     Ok(ConfigOutput {
         summary,
@@ -136,6 +144,47 @@ fn write_pictures(
         &mask_image(w, h, &measured.lit, &reference.truth_front_lit),
     )?;
     Ok([heat, masks])
+}
+
+/// The p95 of `m` per view-depth slice of frame 0 (see [`DepthProfile`]).
+fn depth_profile(kind: TechniqueKind, reference: &Reference, m: &[Option<f64>]) -> DepthProfile {
+    let camera = &reference.frames[0].camera;
+    let (eye, forward) = (camera.eye().as_dvec3(), camera.forward().as_dvec3());
+    let (near, far) = camera
+        .depth_range()
+        .map_or((f64::NAN, f64::NAN), |(n, f)| (f64::from(n), f64::from(f)));
+    let samples = reference
+        .surfaces
+        .iter()
+        .zip(m)
+        .filter_map(|(s, m)| Some(((s.as_ref()?.position - eye).dot(forward), (*m)?)));
+    DepthProfile::new(kind, near, far, samples)
+}
+
+/// Writes `aliasing_<config>.svg`, the aliasing error against view depth of every
+/// technique with the pixel-matched and logarithmic limits; its name.
+fn write_depth_plot(
+    out: &Path,
+    summary: &ConfigSummary,
+    profiles: &[DepthProfile],
+    settings: &Settings,
+) -> Result<PathBuf, EvalError> {
+    let name = PathBuf::from(format!("aliasing_{}.svg", summary.name));
+    let log_limit = summary
+        .log_bound
+        .map(|b| (b * summary.visible_pixels as f64 / settings.texel_budget as f64).sqrt())
+        .filter(|l| l.is_finite() && *l > 0.0);
+    let svg = depth_plot_svg(&DepthPlot {
+        config: &summary.name,
+        profiles,
+        log_limit,
+    })
+    .map_err(|e| EvalError::Write {
+        path: out.join(&name),
+        source: std::io::Error::other(e),
+    })?;
+    write_file(&out.join(&name), &svg)?;
+    Ok(name)
 }
 
 impl Reference {

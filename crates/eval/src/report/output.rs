@@ -9,8 +9,10 @@
 //! report is deleted.
 //!
 //! An existing destination is replaced only when it is empty or holds nothing but
-//! files a report writes (see [`is_report_file`]): `--out` pointed at a directory
-//! of other files is refused, never emptied.
+//! files a report writes (see [`is_report_file`]) and the backend's `rendered/`
+//! directory of PNG images: `--out` pointed at a directory of other files is
+//! refused, never emptied. `rendered/` is not the report's: it is carried over into
+//! the new report as it is.
 
 use std::path::{Path, PathBuf};
 
@@ -27,8 +29,42 @@ pub(super) struct Staging {
 /// Whether `name` is a file `compare` writes (so replacing it loses no user data).
 #[must_use]
 pub(super) fn is_report_file(name: &str) -> bool {
-    matches!(name, "report.md" | "metrics.csv" | "legend.png")
-        || (name.ends_with(".png") && (name.starts_with("heatmap_") || name.starts_with("mask_")))
+    matches!(
+        name,
+        "report.md" | "metrics.csv" | "legend.png" | "index.html" | "colorbar.svg" | "sweep.svg"
+    ) || (name.ends_with(".png") && (name.starts_with("heatmap_") || name.starts_with("mask_")))
+        || (name.ends_with(".svg") && name.starts_with("aliasing_"))
+}
+
+/// The directory of a report where `render_scene` (the wgpu example) writes its
+/// images; carried over from one report to the next.
+pub(super) const RENDERED: &str = "rendered";
+
+/// The PNG files of `report/rendered`, as paths relative to `report`, sorted; empty
+/// when there is none.
+pub(super) fn rendered_images(report: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(report.join(RENDERED)) else {
+        return Vec::new();
+    };
+    let mut names: Vec<String> = entries
+        .filter_map(Result::ok)
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .filter_map(|e| e.file_name().to_str().map(str::to_string))
+        .filter(|n| n.ends_with(".png") && !n.contains(['"', '<', '>', '&']))
+        .map(|n| format!("{RENDERED}/{n}"))
+        .collect();
+    names.sort();
+    names
+}
+
+/// Whether `dir` holds only PNG files (the backend's images).
+fn holds_only_png(dir: &Path) -> bool {
+    std::fs::read_dir(dir).is_ok_and(|entries| {
+        entries.filter_map(Result::ok).all(|e| {
+            e.file_type().is_ok_and(|t| t.is_file())
+                && e.file_name().to_str().is_some_and(|n| n.ends_with(".png"))
+        })
+    })
 }
 
 fn write_error(path: &Path, message: impl Into<String>) -> EvalError {
@@ -65,7 +101,10 @@ fn check_target(target: &Path) -> Result<(), EvalError> {
         })?;
         let name = entry.file_name();
         let is_file = entry.file_type().is_ok_and(|t| t.is_file());
-        if !(is_file && name.to_str().is_some_and(is_report_file)) {
+        let is_rendered = name == RENDERED
+            && entry.file_type().is_ok_and(|t| t.is_dir())
+            && holds_only_png(&entry.path());
+        if !(is_rendered || is_file && name.to_str().is_some_and(is_report_file)) {
             return Err(write_error(
                 target,
                 format!(
@@ -149,13 +188,27 @@ impl Staging {
             self.dir.file_name().unwrap_or_default().to_string_lossy()
         ));
         let had_previous = self.target.exists();
+        // The backend's images move into the new report first.
+        let kept = self.target.join(RENDERED);
+        let carried = self.dir.join(RENDERED);
+        let carry = had_previous && kept.is_dir();
+        if carry {
+            std::fs::rename(&kept, &carried).map_err(|source| rename_error(&kept, source))?;
+        }
         if had_previous {
-            std::fs::rename(&self.target, &previous)
-                .map_err(|source| rename_error(&self.target, source))?;
+            if let Err(source) = std::fs::rename(&self.target, &previous) {
+                if carry {
+                    let _ = std::fs::rename(&carried, &kept);
+                }
+                return Err(rename_error(&self.target, source));
+            }
         }
         if let Err(source) = std::fs::rename(&self.dir, &self.target) {
             if had_previous {
                 let _ = std::fs::rename(&previous, &self.target);
+            }
+            if carry {
+                let _ = std::fs::rename(&carried, &kept);
             }
             return Err(rename_error(&self.target, source));
         }
@@ -180,6 +233,34 @@ mod tests {
     use super::*;
 
     #[test]
+    fn rendered_images_are_kept_and_nothing_else_is_taken_for_them() {
+        let dir = std::env::temp_dir().join(format!("shadowmap-rendered-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let target = dir.join("report");
+        std::fs::create_dir_all(target.join(RENDERED)).unwrap();
+        std::fs::write(target.join("report.md"), "old").unwrap();
+        std::fs::write(target.join("rendered/lispsm.png"), "png").unwrap();
+        assert!(check_target(&target).is_ok());
+        assert_eq!(rendered_images(&target), ["rendered/lispsm.png"]);
+        let staging = Staging::create(&target).unwrap();
+        std::fs::write(staging.path().join("report.md"), "new").unwrap();
+        staging.commit().unwrap();
+        assert_eq!(
+            std::fs::read_to_string(target.join("report.md")).unwrap(),
+            "new"
+        );
+        assert_eq!(
+            rendered_images(&target),
+            ["rendered/lispsm.png"],
+            "carried over"
+        );
+        // A rendered/ holding anything but PNG files is not the backend's.
+        std::fs::write(target.join("rendered/notes.txt"), "mine").unwrap();
+        assert!(check_target(&target).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
     fn report_files_are_recognised() {
         for name in [
             "report.md",
@@ -187,6 +268,10 @@ mod tests {
             "legend.png",
             "heatmap_overhead_lispsm.png",
             "mask_overhead_lispsm.png",
+            "index.html",
+            "colorbar.svg",
+            "sweep.svg",
+            "aliasing_overhead.svg",
         ] {
             assert!(is_report_file(name), "{name}");
         }
@@ -195,6 +280,8 @@ mod tests {
             "heatmap.txt",
             "metrics.csv.bak",
             "photo.png",
+            "aliasing.txt",
+            "index.htm",
             "",
         ] {
             assert!(!is_report_file(name), "{name}");

@@ -13,8 +13,10 @@ use crate::config::{
 use crate::technique::TechniqueKind;
 
 use super::evaluate::{ConfigOutput, evaluate_config};
+use super::html::index_html;
 use super::image::{legend_image, write_png};
-use super::output::Staging;
+use super::output::{Staging, rendered_images};
+use super::plots::{colour_bar_svg, sweep_plot_svg};
 use super::sweep::summarize;
 use super::text::{markdown, metrics_csv};
 use super::{Options, Report, Settings};
@@ -57,6 +59,7 @@ pub fn run(options: &Options) -> Result<Report, EvalError> {
         staging.path(),
         false,
     )?;
+    let rendered = rendered_images(&options.out);
     let mut report = Report {
         settings,
         seed: options.seed,
@@ -78,7 +81,7 @@ pub fn run(options: &Options) -> Result<Report, EvalError> {
     if options.sweep > 0 {
         report.sweep = Some(summarize(&report.sweep_configs, &report.rows));
     }
-    write_report_files(&mut report, staging.path())?;
+    write_report_files(&mut report, staging.path(), &rendered)?;
     staging.commit()?;
     Ok(report)
 }
@@ -116,16 +119,30 @@ fn user_mesh_configuration(
     let name = path
         .file_stem()
         .map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());
+    // The configuration keeps the file's name (it names the pictures, so only
+    // letters, digits, '-' and '_'), apart from the standard configurations'.
+    let config_name = format!(
+        "mesh_{}",
+        name.chars()
+            .map(|c| if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            })
+            .collect::<String>()
+    );
     let extent = mesh.bounds().map_or_else(String::new, |b| {
         let v = |p: glam::Vec3| format!("({:.3e}, {:.3e}, {:.3e})", p.x, p.y, p.z);
         format!(" (bounds {} to {})", v(b.min), v(b.max))
     });
-    mesh_configuration(&name, mesh, config_options).map_err(|e| match e {
+    let mut config = mesh_configuration(&name, mesh, config_options).map_err(|e| match e {
         EvalError::InvalidMesh { message } | EvalError::InvalidView { message } => {
             unusable(format!("cannot frame it{extent} with a camera: {message}"))
         }
         other => other,
-    })
+    })?;
+    config.name = config_name;
+    Ok(config)
 }
 
 fn config_options(options: &Options, settings: &Settings) -> ConfigOptions {
@@ -153,18 +170,53 @@ fn scene_bvhs(configs: &[Configuration]) -> Result<Vec<Arc<Bvh>>, EvalError> {
     Ok(config_bvh)
 }
 
-fn progress_bar(configs: &[Configuration], show: bool) -> indicatif::ProgressBar {
-    if !show {
+/// A bar over every technique of every configuration, labelled `label`, with the
+/// current configuration and technique as its message and an estimate of the time
+/// left; hidden unless `show`.
+fn progress_bar(configs: &[Configuration], show: bool, label: &str) -> indicatif::ProgressBar {
+    if !show || configs.is_empty() {
         return indicatif::ProgressBar::hidden();
     }
     let units: usize = configs
         .iter()
         .map(|c| TechniqueKind::for_light(&c.light).len())
         .sum();
-    indicatif::ProgressBar::with_draw_target(
+    let bar = indicatif::ProgressBar::with_draw_target(
         Some(units as u64),
         indicatif::ProgressDrawTarget::stderr(),
-    )
+    );
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{prefix} [{bar:20}] {pos}/{len} techniques, ETA {eta}: {wide_msg}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_prefix(label.to_string());
+    bar
+}
+
+/// Progress for logs and pipes: one line per finished configuration.
+struct ProgressLines {
+    show: bool,
+    label: &'static str,
+    total: usize,
+    done: AtomicUsize,
+    start: std::time::Instant,
+}
+
+impl ProgressLines {
+    fn finished(&self, config: &Configuration, ok: bool) {
+        if !self.show {
+            return;
+        }
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        let elapsed = self.start.elapsed().as_secs_f64();
+        let left = elapsed / done as f64 * (self.total - done) as f64;
+        let status = if ok { "done" } else { "failed" };
+        eprintln!(
+            "compare: {} {done}/{}: {} {status} ({:.0} s elapsed, about {:.0} s left)",
+            self.label, self.total, config.name, elapsed, left
+        );
+    }
 }
 
 /// Evaluates every configuration on `options.threads` workers, writing pictures
@@ -177,7 +229,23 @@ fn evaluate_all(
     pictures: bool,
 ) -> Result<Vec<ConfigOutput>, EvalError> {
     let config_bvh = scene_bvhs(configs)?;
-    let bar = progress_bar(configs, options.progress);
+    let label = if pictures {
+        "configuration"
+    } else {
+        "sweep case"
+    };
+    let bar = progress_bar(
+        configs,
+        options.progress,
+        if pictures { "compare" } else { "sweep" },
+    );
+    let lines = ProgressLines {
+        show: options.progress_lines,
+        label,
+        total: configs.len(),
+        done: AtomicUsize::new(0),
+        start: std::time::Instant::now(),
+    };
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<Option<Result<ConfigOutput, EvalError>>>> =
         Mutex::new((0..configs.len()).map(|_| None).collect());
@@ -190,6 +258,7 @@ fn evaluate_all(
                     let Some(config) = configs.get(i) else { break };
                     let pictures = pictures.then_some(out);
                     let output = evaluate_config(config, &config_bvh[i], settings, pictures, &bar);
+                    lines.finished(config, output.is_ok());
                     if let Ok(mut r) = results.lock() {
                         r[i] = Some(output);
                     }
@@ -210,18 +279,39 @@ fn evaluate_all(
         .collect()
 }
 
-/// Writes the legend, `metrics.csv` and `report.md`, and lists them in the report.
-fn write_report_files(report: &mut Report, out: &Path) -> Result<(), EvalError> {
+/// Writes the legend, the colour bar, the sweep's plot, `metrics.csv`, `report.md`
+/// and `index.html` (showing the `rendered` images), and lists them in the report.
+fn write_report_files(
+    report: &mut Report,
+    out: &Path,
+    rendered: &[String],
+) -> Result<(), EvalError> {
     let legend = PathBuf::from("legend.png");
     write_png(&out.join(&legend), &legend_image())?;
     report.files.push(legend);
+    let mut svgs = vec![("colorbar.svg", colour_bar_svg())];
+    if let Some(sweep) = &report.sweep {
+        svgs.push(("sweep.svg", sweep_plot_svg(sweep)));
+    }
+    for (name, svg) in svgs {
+        let path = out.join(name);
+        let svg = svg.map_err(|e| EvalError::Write {
+            path: path.clone(),
+            source: std::io::Error::other(e),
+        })?;
+        write_file(&path, &svg)?;
+        report.files.push(PathBuf::from(name));
+    }
+    let html = PathBuf::from("index.html");
+    report.files.push(html.clone());
     let csv = PathBuf::from("metrics.csv");
     write_file(&out.join(&csv), &metrics_csv(report))?;
     report.files.push(csv);
     let md = PathBuf::from("report.md");
     report.files.push(md.clone());
     report.files.sort();
-    write_file(&out.join(&md), &markdown(report))
+    write_file(&out.join(&md), &markdown(report))?;
+    write_file(&out.join(&html), &index_html(report, rendered))
 }
 
 pub(super) fn write_file(path: &Path, text: &str) -> Result<(), EvalError> {

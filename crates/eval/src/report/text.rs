@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 
 use crate::metrics::Summary;
+use crate::technique::TechniqueKind;
 
 use super::sweep::{SweepSummary, TIE_BAND, sweep_table};
 use super::{ConfigSummary, Report, Row, Settings};
@@ -78,7 +79,7 @@ pub fn metrics_csv(report: &Report) -> String {
     s
 }
 
-fn short(x: Option<f64>) -> String {
+pub(super) fn short(x: Option<f64>) -> String {
     match x {
         Some(v) if v.is_finite() => {
             if v != 0.0 && (v.abs() >= 1e4 || v.abs() < 1e-2) {
@@ -91,17 +92,66 @@ fn short(x: Option<f64>) -> String {
     }
 }
 
-fn percent(x: Option<f64>) -> String {
+pub(super) fn percent(x: Option<f64>) -> String {
     x.filter(|v| v.is_finite())
         .map_or_else(|| "-".into(), |v| format!("{:.2}%", v * 100.0))
 }
 
-/// The summary table printed by `compare`: per configuration, each technique's
-/// median and max `m`, `S` and misclassification; then the sweep's wins, ties and
-/// losses when there is one.
+/// The technique of `config` with the lowest p95 `m` (ties: the lower `S`), and
+/// that p95; the RTW oracle is a bound, not a technique, and is not a candidate.
+pub(super) fn best_technique(report: &Report, config: &str) -> Option<(TechniqueKind, f64)> {
+    report
+        .rows
+        .iter()
+        .filter(|r| r.config == config && r.technique != TechniqueKind::RtwOracle)
+        .filter_map(|r| {
+            let m = r.outcome.as_ref().ok()?;
+            let p95 = m.aliasing.m?.p95;
+            p95.is_finite()
+                .then_some((r.technique, p95, m.aliasing.storage_factor))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.2.total_cmp(&b.2)))
+        .map(|(t, p95, _)| (t, p95))
+}
+
+/// One line per measure of the summary table.
+pub(super) const MEASURES: [&str; 3] = [
+    "m    aliasing error: the largest extent of one shadow-map texel on the screen, in \
+     pixels (1 = pixel-matched, above 1 undersampled; lower is better)",
+    "p95  the 95th percentile of m over the visible, front-lit pixels (5% are worse)",
+    "S    storage factor: texels per visible pixel x (max m)^2, the texels needed so that \
+     no texel is larger than a pixel",
+];
+
+/// The summary table printed by `compare`: what `m`, `p95` and `S` mean, then per
+/// configuration each technique's median, p95 and max `m`, `S` and
+/// misclassification; the best technique of each configuration; then the sweep's
+/// wins, ties and losses when there is one.
 #[must_use]
 pub fn summary_table(report: &Report) -> String {
-    let mut s = configuration_table(report);
+    let mut s = String::new();
+    for line in MEASURES {
+        let _ = writeln!(s, "{line}");
+    }
+    s.push('\n');
+    s.push_str(&configuration_table(report));
+    s.push_str("\nbest (lowest p95 m) per configuration:\n");
+    for c in &report.configs {
+        match best_technique(report, &c.name) {
+            Some((kind, p95)) => {
+                let _ = writeln!(
+                    s,
+                    "  {:<14} {} (p95 m {})",
+                    c.name,
+                    kind.name(),
+                    short(Some(p95))
+                );
+            }
+            None => {
+                let _ = writeln!(s, "  {:<14} - (no technique measured)", c.name);
+            }
+        }
+    }
     if let Some(sweep) = &report.sweep {
         let _ = writeln!(
             s,
@@ -118,8 +168,8 @@ fn configuration_table(report: &Report) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<14} {:<16} {:>10} {:>10} {:>10} {:>9}",
-        "config", "technique", "median m", "max m", "S", "misclass"
+        "{:<14} {:<16} {:>10} {:>10} {:>10} {:>10} {:>9}",
+        "config", "technique", "median m", "p95 m", "max m", "S", "misclass"
     );
     let standard = |r: &&Row| report.configs.iter().any(|c| c.name == r.config);
     for row in report.rows.iter().filter(standard) {
@@ -128,10 +178,11 @@ fn configuration_table(report: &Report) -> String {
                 let m = r.aliasing.m;
                 let _ = writeln!(
                     s,
-                    "{:<14} {:<16} {:>10} {:>10} {:>10} {:>9}",
+                    "{:<14} {:<16} {:>10} {:>10} {:>10} {:>10} {:>9}",
                     row.config,
                     row.technique.name(),
                     short(m.map(|m| m.median)),
+                    short(m.map(|m| m.p95)),
                     short(m.map(|m| m.max)),
                     short(Some(r.aliasing.storage_factor)),
                     percent(r.misclassification),
@@ -194,7 +245,9 @@ fn markdown_header(report: &Report) -> String {
         s,
         "Image {}×{} pixels; texel budget {} texels per technique (all layers); camera \
          paths of {} frames; scene seed {}. Produced by \
-         `cargo run --release -p shadowmap-eval --bin compare`.\n",
+         `cargo run --release -p shadowmap-eval --bin compare`. `index.html` beside \
+         this file shows the same report with plots, labelled pictures and sortable \
+         tables.\n",
         st.width, st.height, st.texel_budget, st.path_frames, report.seed
     );
     s.push_str(

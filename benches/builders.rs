@@ -1,0 +1,264 @@
+//! Every per-frame builder timed in one run, beside our transcription of Bevy's
+//! per-frame directional cascade math (`benches/support/bevy_like.rs`, shared with
+//! `cascades_vs_bevy`): uniform focused, stable and tight 4-cascade fits, LiSPSM,
+//! XPSM, TSM, four warped cascades, the spot fit, the IPSM plan with the paper's and
+//! the exact cone, RTW warp tables from a 1-D importance, and camera validation; the
+//! cascade fits and the four single-frustum warps also from a camera validated once
+//! per frame (`ValidCamera`). Besides criterion's figures it prints one table: each
+//! builder's time per call (the fastest of many short batches, see
+//! `support/timing.rs`) and its ratio to Bevy's 4 cascades. `BUILDERS_ONLY` runs one
+//! builder for instruction counting (see `only`).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::{Quat, Vec3};
+use shadowmap::frustum::{
+    Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light,
+    Projection, SceneBounds, SplitScheme, ValidCamera, fit_spot,
+};
+use shadowmap::paraboloid::{ConeFit, IpsmOptions, IpsmPlan};
+use shadowmap::rtw::{ImportanceMap, WarpMaps, WarpOptions};
+use shadowmap::warp::{
+    FocusBody, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
+    uniform_focused, warped_cascades, xpsm,
+};
+use std::hint::black_box;
+use std::time::Duration;
+
+#[allow(dead_code)] // Only the cascades bench reads every output field and constant.
+#[path = "support/bevy_like.rs"]
+mod bevy_like;
+#[path = "support/timing.rs"]
+mod timing;
+
+/// Everything the builders read: Bevy's default camera and cascade configuration, a
+/// ground plane with a block of casters, a spot and a point light.
+struct Frame {
+    camera: Camera,
+    light: Vec3,
+    light_rotation: Quat,
+    far_bounds: [f32; bevy_like::CASCADES],
+    splits: CascadeSplits,
+    stable: CascadeOptions,
+    tight: CascadeOptions,
+    scene: SceneBounds,
+    spot: Light,
+    point: Light,
+    bounds: DepthBounds,
+    importance: ImportanceMap,
+    valid: ValidCamera,
+}
+
+fn frame() -> Frame {
+    use bevy_like::{CASCADES, MAP_SIZE, MAX_DISTANCE, MIN_DISTANCE, OVERLAP};
+    let camera = Camera::look_to(
+        Vec3::new(10.0, 1.8, 3.0),
+        Vec3::new(0.3, -0.15, -1.0),
+        Vec3::Y,
+        Projection::perspective(core::f32::consts::FRAC_PI_4, 16.0 / 9.0, 0.1, 1000.0),
+    )
+    .unwrap();
+    let light = Vec3::new(-0.4, -1.0, -0.6).normalize();
+    let far_bounds = bevy_like::far_bounds();
+    let interior = SplitScheme::Custom(far_bounds[..CASCADES - 1].iter().copied().collect());
+    let splits = CascadeSplits::new(&interior, CASCADES, MIN_DISTANCE, MAX_DISTANCE)
+        .unwrap()
+        .with_overlap(OVERLAP)
+        .unwrap();
+    let stable = CascadeOptions::default().with_resolution(MAP_SIZE as u32);
+    let ground = Aabb::new(
+        Vec3::new(-600.0, -1.0, -600.0),
+        Vec3::new(600.0, 0.0, 600.0),
+    );
+    let scene = SceneBounds::new(
+        ground,
+        ground.union(&Aabb::new(Vec3::ZERO, Vec3::splat(80.0))),
+    );
+    // A 1-D importance: one row of 1024 cells with a peak.
+    let mut importance = ImportanceMap::new(1024, 1).unwrap();
+    let row: Vec<f32> = (0..1024)
+        .map(|i| {
+            let x = i as f32 / 1024.0 - 0.3;
+            0.05 + (-x * x * 400.0).exp()
+        })
+        .collect();
+    importance.copy_from_slice(&row).unwrap();
+    Frame {
+        camera,
+        light,
+        light_rotation: Quat::from_rotation_arc(Vec3::NEG_Z, light),
+        far_bounds,
+        splits,
+        stable,
+        tight: stable.with_fit(CascadeFit::Tight),
+        scene,
+        spot: Light::Spot {
+            position: Vec3::new(30.0, 25.0, -20.0),
+            direction: Vec3::new(-0.5, -1.0, 0.2),
+            half_angle: 0.6,
+            range: 200.0,
+        },
+        point: Light::Point {
+            position: Vec3::new(60.0, 20.0, -40.0),
+            range: 2000.0,
+        },
+        bounds: DepthBounds {
+            min: 0.5,
+            max: 80.0,
+        },
+        importance,
+        valid: ValidCamera::new(&camera).unwrap(),
+    }
+}
+
+/// The builders, by name.
+const NAMES: [&str; 16] = [
+    "bevy_cascades_4",
+    "uniform_focused",
+    "stable_cascades_4",
+    "tight_cascades_4",
+    "lispsm",
+    "xpsm",
+    "tsm",
+    "warped_cascades_4",
+    "spot_fit",
+    "ipsm_plan_paper_cone",
+    "ipsm_plan_exact_cone",
+    "rtw_tables_1d_1024",
+    "camera_validate",
+    "stable_cascades_4_valid",
+    "tight_cascades_4_valid",
+    "focus_body_valid_all_4",
+];
+
+/// Runs builder `which` once on `f` (`warps` is the RTW output buffer).
+fn run(f: &Frame, warps: &mut WarpMaps, which: usize) {
+    let cam = black_box(&f.camera);
+    let light = black_box(f.light);
+    match which {
+        0 => {
+            black_box(bevy_like::cascades(
+                black_box(f.light_rotation),
+                black_box(f.camera.world_from_view),
+                core::f32::consts::FRAC_PI_4,
+                16.0 / 9.0,
+                &f.far_bounds,
+            ));
+        }
+        1 => {
+            let o = UniformOptions::default();
+            black_box(uniform_focused(cam, light, &f.scene, &o).unwrap());
+        }
+        2 => {
+            black_box(CascadeSet::fit(cam, light, &f.splits, &f.stable).unwrap());
+        }
+        3 => {
+            black_box(CascadeSet::fit(cam, light, &f.splits, &f.tight).unwrap());
+        }
+        4 => {
+            black_box(lispsm(cam, light, &f.scene, &LispsmOptions::default()).unwrap());
+        }
+        5 => {
+            black_box(xpsm(cam, light, &f.scene, &XpsmOptions::default()).unwrap());
+        }
+        6 => {
+            black_box(tsm(cam, light, &f.scene, &TsmOptions::default()).unwrap());
+        }
+        7 => {
+            let etas = [0.0, 0.0, -0.5, -1.0];
+            let o = LispsmOptions::default();
+            black_box(warped_cascades(cam, light, &f.scene, &f.splits, &etas, &o).unwrap());
+        }
+        8 => {
+            let frustum = cam.frustum().unwrap();
+            black_box(fit_spot(black_box(&f.spot), &frustum, Some(&f.scene), false).unwrap());
+        }
+        9 | 10 => {
+            let fit = if which == 9 {
+                ConeFit::Paper
+            } else {
+                ConeFit::Exact
+            };
+            let o = IpsmOptions::default().with_fit(fit);
+            black_box(IpsmPlan::new(black_box(&f.point), cam, Some(f.bounds), &o).unwrap());
+        }
+        11 => {
+            warps
+                .build(black_box(&f.importance), &WarpOptions::default())
+                .unwrap();
+            black_box(warps.x_table());
+        }
+        12 => {
+            black_box(cam.validate().is_ok());
+        }
+        13 => {
+            black_box(CascadeSet::fit_valid(&f.valid, light, &f.splits, &f.stable).unwrap());
+        }
+        14 => {
+            black_box(CascadeSet::fit_valid(&f.valid, light, &f.splits, &f.tight).unwrap());
+        }
+        15 => {
+            let body = FocusBody::new_valid(black_box(&f.valid), light, &f.scene).unwrap();
+            black_box(body.uniform(&UniformOptions::default()).unwrap());
+            black_box(body.lispsm(&LispsmOptions::default()).unwrap());
+            black_box(body.xpsm(&XpsmOptions::default()).unwrap());
+            black_box(body.tsm(&TsmOptions::default()).unwrap());
+        }
+        _ => unreachable!("no builder {which}"),
+    }
+}
+
+/// With `BUILDERS_ONLY=<name>` (and `BUILDERS_CALLS=<n>`, default 1), calls that one
+/// builder `n` times and times nothing: run under `valgrind --tool=callgrind` with two
+/// values of `n`, the difference of the instruction counts divided by the difference
+/// of `n` is the builder's instructions per call, repeatable on a loaded machine.
+fn only(f: &Frame, warps: &mut WarpMaps) -> bool {
+    let Ok(name) = std::env::var("BUILDERS_ONLY") else {
+        return false;
+    };
+    let calls: usize = std::env::var("BUILDERS_CALLS")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(1);
+    let which = NAMES
+        .iter()
+        .position(|n| *n == name)
+        .unwrap_or_else(|| panic!("BUILDERS_ONLY: no builder {name}; one of {NAMES:?}"));
+    for _ in 0..calls {
+        run(f, warps, which);
+    }
+    true
+}
+
+#[allow(clippy::print_stdout)] // The table is this bench's output.
+fn builders(c: &mut Criterion) {
+    let f = frame();
+    let mut warps = WarpMaps::new(1024, 1).unwrap();
+    if only(&f, &mut warps) {
+        return;
+    }
+    let mut g = c.benchmark_group("builders");
+    g.warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(1));
+    for (i, name) in NAMES.iter().enumerate() {
+        g.bench_function(*name, |b| b.iter(|| run(&f, &mut warps, i)));
+    }
+    g.finish();
+
+    let bevy = timing::min_ns(|| run(&f, &mut warps, 0));
+    println!("builders, one run (time per call, fastest of 201 batches):");
+    for (i, name) in NAMES.iter().enumerate() {
+        let t = if i == 0 {
+            bevy
+        } else {
+            timing::min_ns(|| run(&f, &mut warps, i))
+        };
+        println!(
+            "  {name:<22} {:>9.3} us  {:>7.2}x bevy_cascades_4",
+            t * 1e-3,
+            t / bevy
+        );
+    }
+}
+
+criterion_group!(benches, builders);
+criterion_main!(benches);
