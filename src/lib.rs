@@ -1,4 +1,5 @@
-//! `shadowmap`: every serious shadow-map parameterization as small GPU-free crates.
+//! `shadowmap`: every serious shadow-map parameterization as small GPU-free crates,
+//! and one vocabulary to switch between them by value.
 //!
 //! This umbrella crate re-exports the member crates, one feature each:
 //!
@@ -8,6 +9,93 @@
 //! | `warp` | `warp` | focus region, LiSPSM, XPSM, TSM |
 //! | `paraboloid` | `paraboloid` | dual-paraboloid maps, IPSM |
 //! | `rtw` | `rtw` | rectilinear texture warping |
+//!
+//! With all four (the default), it adds the face an engine uses: a [`Technique`]
+//! value, one [`fit`] that takes the same [`FitInput`] (camera, light, scene bounds,
+//! texel budget, plus the optional inputs some techniques read) for every technique,
+//! and the fitted [`Shadow`], which owns the math crate's own result ([`Fitted`]),
+//! says which technique was fitted (`auto`'s choice), its layers and layer side, and
+//! is a [`ShadowMapping`](frustum::ShadowMapping) (world point to shadow `uv`, depth
+//! and layer).
+//!
+//! # Example
+//!
+//! Switch technique by a setting; everything else stays the same:
+//!
+//! ```
+//! # #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))] {
+//! use shadowmap::frustum::glam::{DVec3, Vec3};
+//! use shadowmap::frustum::{Aabb, Camera, Light, Projection, SceneBounds, ShadowMapping};
+//! use shadowmap::{FitInput, Technique, fit};
+//!
+//! let camera = Camera::look_to(
+//!     Vec3::new(0.0, 2.0, 0.0),
+//!     Vec3::NEG_Z,
+//!     Vec3::Y,
+//!     Projection::perspective(1.0, 16.0 / 9.0, 0.5, 200.0),
+//! )
+//! .unwrap();
+//! let light = Light::Directional { direction: Vec3::new(0.3, -1.0, 0.2) };
+//! let scene = SceneBounds::whole(Aabb::new(Vec3::new(-100.0, 0.0, -220.0), Vec3::new(100.0, 20.0, 10.0)));
+//! let input = FitInput::new(&camera, &light, scene, 2048 * 2048);
+//!
+//! for technique in [
+//!     Technique::UniformFocused(Default::default()),
+//!     Technique::Lispsm(Default::default()),
+//!     Technique::StableCascades(Default::default()),
+//!     Technique::Auto(Default::default()),
+//! ] {
+//!     let shadow = fit(&technique, &input)?;
+//!     assert!(shadow.texels() <= 2048 * 2048);
+//!     // A visible ground point lands inside the map.
+//!     let s = shadow.map_point(DVec3::new(1.0, 0.0, -30.0)).unwrap();
+//!     assert!((0.0..=1.0).contains(&s.uv.x) && (0.0..=1.0).contains(&s.uv.y));
+//!     assert!(s.layer < shadow.layers());
+//! }
+//! // RTW needs the eye's samples: a typed error says so.
+//! let rtw = fit(&Technique::Rtw(Default::default()), &input);
+//! assert!(matches!(rtw, Err(shadowmap::FitError::MissingInput { input: "eye_samples", .. })));
+//! # }
+//! # Ok::<(), shadowmap::FitError>(())
+//! ```
+//!
+//! # Techniques
+//!
+//! The budget is split evenly over the layers: `k` layers of side
+//! `floor(sqrt(budget / k))`. Optional inputs: **S** eye samples, **D** depth bounds
+//! (the camera's range without them), **P** pixels per radian; bold = required.
+//!
+//! | [`Technique`] | light | layers | reads | paper |
+//! |---|---|---|---|---|
+//! | `UniformFocused` | directional | 1 | | focused orthographic fit |
+//! | `StableCascades`, `TightCascades` | directional | 1..=8 | D | Zhang et al., *Parallel-split shadow maps* (practical splits); Lauritzen et al., *Sample distribution shadow maps* (tight fit to the depth bounds) |
+//! | `Lispsm` | directional | 1 | | Wimmer, Scherzer and Purgathofer, *Light space perspective shadow maps* |
+//! | `Xpsm` | directional | 1 | | Gusev, *Extended perspective shadow maps* |
+//! | `Tsm` | directional | 1 | | Martin and Tan, *Anti-aliasing and continuity with trapezoidal shadow maps* |
+//! | `WarpedCascades` | directional | 1..=8 | D | PSSM with LiSPSM per cascade |
+//! | `Auto` | directional | as chosen | D | lowest predicted error among [`auto_candidates`] |
+//! | `Rtw` | directional | 1 | **S** | Rosen, *Rectilinear texture warping for fast adaptive shadow mapping* |
+//! | `RtwOracle` | directional | 1 | **S**, **P** | RTW fed the exact required density (a limit, not a technique) |
+//! | `SpotFit` | spot | 1 | | perspective fit to frustum ∩ receivers |
+//! | `Dpsm` | point | 2 | | Brabec, Annen and Seidel, *Shadow mapping for hemispherical and omnidirectional light sources* |
+//! | `Ipsm` | point | 1 or 2 | D | Vanek, Navrátil, Herout and Zemčík, *High-quality shadows with improved paraboloid mapping*; `ConeFit::Exact` uses the exact minimal enclosing cone |
+//!
+//! Cascade count: with depth bounds of ratio `r = max / min` and `k` maps sharing the
+//! budget, each cascade of a logarithmic split covers a ratio `r^(1/k)` on `side(k)`
+//! texels; the count minimizing `r^(1/k) / side(k)` up to
+//! [`CascadePlan::max_cascades`] is taken, preferring power-of-two sides.
+//!
+//! `auto` fits every candidate and keeps the lowest predicted 95th-percentile error
+//! (`shadowmap_frustum::predict_errors`, from camera, light and bounds alone: no
+//! rendering). [`fit`] chooses on one frame; [`fit_with_selector`] with a
+//! caller-held [`TechniqueSelector`](frustum::TechniqueSelector) keeps the choice
+//! until another candidate is better by its margin, so the technique does not flicker.
+//!
+//! # Errors and allocation
+//!
+//! [`fit`] never panics: [`FitError`] says which input is wrong or missing, or wraps
+//! the math crate's own error. Every fit is allocation-free except RTW (its
+//! importance map and warp tables) and the RTW oracle.
 #![cfg_attr(not(feature = "std"), no_std)]
 
 #[cfg(feature = "frustum")]
@@ -18,3 +106,24 @@ pub use shadowmap_paraboloid as paraboloid;
 pub use shadowmap_rtw as rtw;
 #[cfg(feature = "warp")]
 pub use shadowmap_warp as warp;
+
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+extern crate alloc;
+
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod auto;
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod fit;
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod shadow;
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod technique;
+
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+pub use auto::{AUTO_CANDIDATE_COUNT, auto_candidates};
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+pub use fit::{FitError, FitInput, depth_bounds_of, fit, fit_with_selector, layer_side};
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+pub use shadow::{Fitted, Shadow};
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+pub use technique::{CascadePlan, DpsmOptions, LightKind, RtwPlan, Technique};

@@ -1,10 +1,11 @@
 //! The techniques under comparison, built for one frame of a configuration at an
 //! equal texel budget.
 //!
-//! [`TechniqueKind`] lists them; [`Technique::build`] fits one to a frame
-//! ([`FrameContext`]: camera, light, scene bounds, the eye's visible samples) and
-//! returns something that is both a [`ShadowMapping`] (the lookup the metrics
-//! measure) and a depth pass for the reference rasterizer
+//! [`TechniqueKind`] lists them, each an umbrella [`shadowmap::Technique`] value
+//! ([`TechniqueKind::technique`]); [`Technique::build`] fits one to a frame
+//! ([`FrameContext`]: camera, light, scene bounds, the eye's visible samples) with
+//! [`shadowmap::fit`] and returns something that is both a [`ShadowMapping`] (the
+//! lookup the metrics measure) and a depth pass for the reference rasterizer
 //! ([`Technique::rasterize`]), with its per-layer resolution.
 //!
 //! | light | techniques |
@@ -20,22 +21,10 @@
 //! [`EvalError::Technique`] with the math crate's reason, never panics.
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
-use shadowmap_frustum::{
-    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light, SceneBounds,
-    ShadowMapping, ShadowSample, ShadowTransform, SplitScheme, fit_spot,
-};
-use shadowmap_paraboloid::{
-    ConeFit, IpsmOptions, IpsmPlan, MapOptions, ParaboloidMap, Side, SubdivisionOptions,
-    subdivide_triangles,
-};
-use shadowmap_rtw::{
-    EyeSample, ImportanceMap, ImportanceOptions, OracleAxis, RtwShadow, RtwSubdivision, WarpMaps,
-    WarpOptions, subdivide_for_rtw,
-};
-use shadowmap_warp::{
-    LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm, uniform_focused,
-    warped_cascades, xpsm,
-};
+use shadowmap::paraboloid::{ConeFit, IpsmOptions, Side, SubdivisionOptions, subdivide_triangles};
+use shadowmap::rtw::{EyeSample, RtwSubdivision, subdivide_for_rtw};
+use shadowmap::{CascadePlan, FitInput, Fitted, RtwPlan, Shadow, depth_bounds_of, fit};
+use shadowmap_frustum::{Camera, Light, SceneBounds, ShadowMapping, ShadowSample};
 
 use crate::EvalError;
 use crate::mask::GBuffer;
@@ -133,24 +122,47 @@ impl TechniqueKind {
 
     /// Whether the technique is meant for this kind of light.
     #[must_use]
-    pub const fn applies_to(self, light: &Light) -> bool {
-        match light {
-            Light::Directional { .. } => matches!(
-                self,
-                Self::UniformFocused
-                    | Self::StableCascades
-                    | Self::TightCascades
-                    | Self::Lispsm
-                    | Self::Xpsm
-                    | Self::Tsm
-                    | Self::WarpedCascades
-                    | Self::Auto
-                    | Self::Rtw
-                    | Self::RtwOracle
-            ),
-            Light::Spot { .. } => matches!(self, Self::SpotFit),
-            Light::Point { .. } => matches!(self, Self::Dpsm | Self::IpsmPaper | Self::IpsmExact),
+    pub fn applies_to(self, light: &Light) -> bool {
+        self.technique(&TechniqueOptions::default())
+            .applies_to(light)
+    }
+
+    /// The umbrella crate's technique value for this kind, with the comparison's
+    /// options (default options of each builder; cascades, splits and RTW's map side
+    /// from `options`).
+    #[must_use]
+    pub fn technique(self, options: &TechniqueOptions) -> shadowmap::Technique {
+        use shadowmap::Technique as T;
+        let plan = CascadePlan::default()
+            .with_max_cascades(options.cascades)
+            .with_split_lambda(options.split_lambda);
+        let rtw = RtwPlan::default().with_importance_side(options.rtw_importance_side);
+        let ipsm = |fit| T::Ipsm(IpsmOptions::default().with_fit(fit));
+        match self {
+            Self::UniformFocused => T::UniformFocused(Default::default()),
+            Self::StableCascades => T::StableCascades(plan),
+            Self::TightCascades => T::TightCascades(plan),
+            Self::Lispsm => T::Lispsm(Default::default()),
+            Self::Xpsm => T::Xpsm(Default::default()),
+            Self::Tsm => T::Tsm(Default::default()),
+            Self::WarpedCascades => T::WarpedCascades {
+                plan,
+                lispsm: Default::default(),
+            },
+            Self::Auto => T::Auto(plan),
+            Self::Rtw => T::Rtw(rtw),
+            Self::RtwOracle => T::RtwOracle(rtw),
+            Self::SpotFit => T::SpotFit { reversed_z: false },
+            Self::Dpsm => T::Dpsm(Default::default()),
+            Self::IpsmPaper => ipsm(ConeFit::Paper),
+            Self::IpsmExact => ipsm(ConeFit::Exact),
         }
+    }
+
+    /// The kind of an umbrella technique value (by [`shadowmap::Technique::name`]).
+    #[must_use]
+    pub fn of(technique: &shadowmap::Technique) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == technique.name())
     }
 
     /// The techniques for a light, in report order.
@@ -211,8 +223,7 @@ impl TechniqueOptions {
     /// Side of each of `layers` square maps sharing the budget.
     #[must_use]
     pub fn layer_side(&self, layers: u32) -> u32 {
-        let per = self.texel_budget / u64::from(layers.max(1));
-        ((per as f64).sqrt().floor() as u32).max(4)
+        shadowmap::layer_side(self.texel_budget, layers)
     }
 }
 
@@ -248,52 +259,14 @@ pub fn eye_samples(gbuffer: &GBuffer, camera: &Camera) -> Vec<EyeSample> {
         .collect()
 }
 
-enum Inner {
-    /// One matrix map.
-    Matrix(ShadowTransform),
-    /// Stable cascades.
-    Cascades(Box<CascadeSet>),
-    /// Warped cascades: view-depth ranges and fits (`None`: slice without receivers).
-    Warped {
-        eye: DVec3,
-        forward: DVec3,
-        cascades: Vec<((f64, f64), Option<ShadowTransform>)>,
-    },
-    /// A paraboloid map (single or dual).
-    Paraboloid(ParaboloidMap),
-    /// RTW: base fit and warp tables.
-    Rtw {
-        base: ShadowTransform,
-        warps: Box<WarpMaps>,
-    },
-}
-
-/// A technique fitted to one frame.
+/// A technique fitted to one frame through [`shadowmap::fit`], with its depth pass
+/// for the reference rasterizer.
+#[derive(Debug)]
 pub struct Technique {
     kind: TechniqueKind,
     /// The technique that was fitted: `kind` itself, or the candidate `auto` chose.
     chosen: TechniqueKind,
-    inner: Inner,
-    layers: u32,
-    side: u32,
-}
-
-impl core::fmt::Debug for Technique {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("Technique")
-            .field("kind", &self.kind)
-            .field("chosen", &self.chosen)
-            .field("layers", &self.layers)
-            .field("side", &self.side)
-            .finish_non_exhaustive()
-    }
-}
-
-fn fail(kind: TechniqueKind, reason: &dyn core::fmt::Display) -> EvalError {
-    EvalError::Technique {
-        technique: kind.name(),
-        reason: reason.to_string(),
-    }
+    shadow: Shadow,
 }
 
 /// A depth-pass matrix that clips everything (unused cascade layers).
@@ -304,8 +277,16 @@ const CLIP_ALL: DMat4 = DMat4::from_cols(
     DVec4::new(0.0, 0.0, -1.0, 1.0),
 );
 
+fn fail(kind: TechniqueKind, reason: &dyn core::fmt::Display) -> EvalError {
+    EvalError::Technique {
+        technique: kind.name(),
+        reason: reason.to_string(),
+    }
+}
+
 impl Technique {
-    /// Fits `kind` to a frame.
+    /// Fits `kind` to a frame with [`shadowmap::fit`] (eye samples, their depth
+    /// bounds and the image's focal length as the optional inputs).
     ///
     /// # Errors
     /// [`EvalError::Technique`] when the technique does not apply to the light or its
@@ -315,191 +296,16 @@ impl Technique {
         frame: &FrameContext<'_>,
         options: &TechniqueOptions,
     ) -> Result<Self, EvalError> {
-        if !kind.applies_to(frame.light) {
-            return Err(fail(kind, &"not for this kind of light"));
-        }
-        if kind == TechniqueKind::Auto {
-            return Self::build_auto(frame, options);
-        }
-        let focus = frame.scene;
-        let camera = frame.camera;
-        let direction = match *frame.light {
-            Light::Directional { direction } => direction,
-            _ => Vec3::ZERO,
-        };
-        let single = options.layer_side(1);
-        let e = |err: &dyn core::fmt::Display| fail(kind, err);
-        let (inner, layers, side) = match kind {
-            TechniqueKind::UniformFocused => {
-                let t = uniform_focused(camera, direction, &focus, &UniformOptions::default())
-                    .map_err(|x| e(&x))?;
-                (Inner::Matrix(t), 1, single)
-            }
-            TechniqueKind::Lispsm => {
-                let t = lispsm(camera, direction, &focus, &LispsmOptions::default())
-                    .map_err(|x| e(&x))?;
-                (Inner::Matrix(t.transform), 1, single)
-            }
-            TechniqueKind::Xpsm => {
-                let t =
-                    xpsm(camera, direction, &focus, &XpsmOptions::default()).map_err(|x| e(&x))?;
-                (Inner::Matrix(t.transform), 1, single)
-            }
-            TechniqueKind::Tsm => {
-                let t =
-                    tsm(camera, direction, &focus, &TsmOptions::default()).map_err(|x| e(&x))?;
-                (Inner::Matrix(t.transform), 1, single)
-            }
-            TechniqueKind::StableCascades | TechniqueKind::TightCascades => {
-                let splits =
-                    cascade_splits(camera, frame.eye_samples, options).map_err(|x| e(&x))?;
-                let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
-                let side = options.layer_side(layers);
-                let fit = CascadeOptions::default()
-                    .with_resolution(side)
-                    .with_scene(Some(frame.scene));
-                let fit = if kind == TechniqueKind::StableCascades {
-                    fit.with_stable_size_step(Some(STABLE_SIZE_STEP))
-                } else {
-                    fit.with_fit(CascadeFit::Tight)
-                };
-                let set = CascadeSet::fit(camera, direction, &splits, &fit).map_err(|x| e(&x))?;
-                (Inner::Cascades(Box::new(set)), layers, side)
-            }
-            TechniqueKind::WarpedCascades => {
-                // The same split rule as the unwarped cascades: count and range from
-                // the eye's depth bounds, so no cascade is spent on empty depth.
-                let splits =
-                    cascade_splits(camera, frame.eye_samples, options).map_err(|x| e(&x))?;
-                let count = splits.count();
-                let layers = u32::try_from(count).unwrap_or(u32::MAX);
-                let side = options.layer_side(layers);
-                let etas = vec![0.0; count];
-                let w = warped_cascades(
-                    camera,
-                    direction,
-                    &focus,
-                    &splits,
-                    &etas,
-                    &LispsmOptions::default(),
-                )
-                .map_err(|x| e(&x))?;
-                let cascades = w
-                    .cascades
-                    .iter()
-                    .map(|c| {
-                        (
-                            (f64::from(c.near), f64::from(c.far)),
-                            c.shadow.map(|s| s.transform),
-                        )
-                    })
-                    .collect();
-                (
-                    Inner::Warped {
-                        eye: camera.eye().as_dvec3(),
-                        forward: camera.forward().as_dvec3(),
-                        cascades,
-                    },
-                    layers,
-                    side,
-                )
-            }
-            TechniqueKind::Auto => return Self::build_auto(frame, options),
-            TechniqueKind::Rtw | TechniqueKind::RtwOracle => {
-                let base = uniform_focused(camera, direction, &focus, &UniformOptions::default())
-                    .map_err(|x| e(&x))?;
-                let n = options.rtw_importance_side;
-                let mut map = ImportanceMap::new(n, n).map_err(|x| e(&x))?;
-                let mut warps = Box::new(WarpMaps::new(n, n).map_err(|x| e(&x))?);
-                if kind == TechniqueKind::Rtw {
-                    map.accumulate_backward(
-                        &base,
-                        frame.eye_samples,
-                        None,
-                        &ImportanceOptions::default(),
-                    )
-                    .map_err(|x| e(&x))?;
-                    warps
-                        .build(&map, &WarpOptions::default())
-                        .map_err(|x| e(&x))?;
-                } else {
-                    // The oracle of a separable warp: each axis gets the density that
-                    // axis needs (an isotropic requirement would spend texels on the
-                    // axis that does not need them). Perspective-only (zero normal):
-                    // true-normal requirements of surfaces seen edge-on are unbounded
-                    // and, once normalized, starve the rest of the map.
-                    let mut map_v = ImportanceMap::new(n, n).map_err(|x| e(&x))?;
-                    let flat: Vec<EyeSample> = frame
-                        .eye_samples
-                        .iter()
-                        .map(|s| EyeSample {
-                            normal: glam::Vec3::ZERO,
-                            ..*s
-                        })
-                        .collect();
-                    for (axis, m) in [(OracleAxis::U, &mut map), (OracleAxis::V, &mut map_v)] {
-                        m.accumulate_oracle_axis(
-                            axis,
-                            &base,
-                            camera,
-                            frame.pixels_per_radian,
-                            &flat,
-                        )
-                        .map_err(|x| e(&x))?;
-                    }
-                    warps
-                        .build_separable(&map, &map_v, &WarpOptions::default())
-                        .map_err(|x| e(&x))?;
-                }
-                (Inner::Rtw { base, warps }, 1, single)
-            }
-            TechniqueKind::SpotFit => {
-                let frustum = camera.frustum().map_err(|x| e(&x))?;
-                let s = fit_spot(frame.light, &frustum, Some(&frame.scene), false)
-                    .map_err(|x| e(&x))?;
-                (Inner::Matrix(s.transform), 1, single)
-            }
-            TechniqueKind::Dpsm => {
-                let (position, range) =
-                    point_of(frame.light).ok_or_else(|| e(&"not a point light"))?;
-                let map = ParaboloidMap::dual(
-                    position,
-                    Vec3::NEG_Y,
-                    IpsmOptions::default().near,
-                    range,
-                    &MapOptions::default(),
-                )
-                .map_err(|x| e(&x))?;
-                (Inner::Paraboloid(map), 2, options.layer_side(2))
-            }
-            TechniqueKind::IpsmPaper | TechniqueKind::IpsmExact => {
-                let fit = if kind == TechniqueKind::IpsmPaper {
-                    ConeFit::Paper
-                } else {
-                    ConeFit::Exact
-                };
-                let bounds = depth_bounds(camera, frame.eye_samples);
-                let plan = IpsmPlan::new(
-                    frame.light,
-                    camera,
-                    bounds,
-                    &IpsmOptions::default().with_fit(fit),
-                )
-                .map_err(|x| e(&x))?;
-                let layers = plan.map.layers();
-                (
-                    Inner::Paraboloid(plan.map),
-                    layers,
-                    options.layer_side(layers),
-                )
-            }
-        };
+        let input = FitInput::new(frame.camera, frame.light, frame.scene, options.texel_budget)
+            .with_eye_samples(frame.eye_samples)
+            .with_depth_bounds(depth_bounds_of(frame.camera, frame.eye_samples))
+            .with_pixels_per_radian(frame.pixels_per_radian);
+        let shadow = fit(&kind.technique(options), &input).map_err(|e| fail(kind, &e))?;
+        let chosen = TechniqueKind::of(shadow.technique()).unwrap_or(kind);
         Ok(Self {
             kind,
-            chosen: kind,
-            inner,
-            layers,
-            side,
+            chosen,
+            shadow,
         })
     }
 
@@ -516,31 +322,35 @@ impl Technique {
         self.chosen
     }
 
+    /// The fitted shadow.
+    #[must_use]
+    pub const fn shadow(&self) -> &Shadow {
+        &self.shadow
+    }
+
     /// Number of layers (cascades, paraboloid sides).
     #[must_use]
     pub const fn layers(&self) -> u32 {
-        self.layers
+        self.shadow.layers()
     }
 
     /// Resolution `(width, height)` of each layer.
     #[must_use]
     pub fn layer_sizes(&self) -> Vec<(u32, u32)> {
-        vec![(self.side, self.side); self.layers as usize]
+        let side = self.shadow.layer_side();
+        vec![(side, side); self.layers() as usize]
     }
 
     /// Texels over all layers.
     #[must_use]
-    pub fn texels(&self) -> u64 {
-        u64::from(self.side) * u64::from(self.side) * u64::from(self.layers)
+    pub const fn texels(&self) -> u64 {
+        self.shadow.texels()
     }
 
     /// The paraboloid map, for paraboloid techniques (e.g. to tell single from dual).
     #[must_use]
-    pub const fn paraboloid(&self) -> Option<&ParaboloidMap> {
-        match &self.inner {
-            Inner::Paraboloid(m) => Some(m),
-            _ => None,
-        }
+    pub const fn paraboloid(&self) -> Option<&shadowmap::paraboloid::ParaboloidMap> {
+        self.shadow.paraboloid()
     }
 
     /// Renders the technique's depth map of `mesh` with the reference rasterizer.
@@ -551,70 +361,77 @@ impl Technique {
     /// # Errors
     /// The rasterizer's errors; [`EvalError::Technique`] when subdivision fails.
     pub fn rasterize(&self, mesh: &Mesh, options: &RasterOptions) -> Result<DepthMap, EvalError> {
-        let options = options.with_size(self.side, self.side);
-        match &self.inner {
-            Inner::Matrix(t) => rasterize_depth(mesh, &MatrixProjector::from(t), &options),
-            Inner::Cascades(set) => {
-                rasterize_depth(mesh, &MatrixProjector::from(set.as_ref()), &options)
-            }
-            Inner::Warped { cascades, .. } => {
+        let side = self.shadow.layer_side();
+        let options = options.with_size(side, side);
+        if let Some(t) = self.shadow.transform() {
+            return rasterize_depth(mesh, &MatrixProjector::from(t), &options);
+        }
+        if let Some(map) = self.shadow.paraboloid() {
+            return self.rasterize_paraboloid(map, mesh, &options);
+        }
+        if let Some(shadow) = self.shadow.rtw() {
+            // The depth pass warps vertices only: the same crack-free caster
+            // subdivision as the GPU depth pass, for a map of this side.
+            let triangles: Vec<[Vec3; 3]> =
+                mesh.triangles().map(|t| t.map(DVec3::as_vec3)).collect();
+            let subdivision = RtwSubdivision::default().with_resolution(side);
+            let mut pieces = Vec::new();
+            subdivide_for_rtw(&shadow, &triangles, &subdivision, &mut pieces);
+            return rasterize_depth(&mesh_of(&pieces), &RtwProjector::from(shadow), &options);
+        }
+        match self.shadow.fitted() {
+            Fitted::Cascades(set) => rasterize_depth(mesh, &MatrixProjector::from(set), &options),
+            Fitted::WarpedCascades { cascades, .. } => {
                 let matrices = cascades
+                    .cascades
                     .iter()
-                    .map(|(_, t)| t.map_or(CLIP_ALL, |t| t.clip_from_world.as_dmat4()))
+                    .map(|c| {
+                        c.shadow
+                            .map_or(CLIP_ALL, |s| s.transform.clip_from_world.as_dmat4())
+                    })
                     .collect();
                 rasterize_depth(mesh, &MatrixProjector::new(matrices, false), &options)
             }
-            Inner::Rtw { base, warps } => {
-                let shadow = RtwShadow {
-                    base: *base,
-                    warps: warps.as_ref(),
-                };
-                // The depth pass warps vertices only: the same crack-free caster
-                // subdivision as the GPU depth pass, for a map of this side.
-                let triangles: Vec<[Vec3; 3]> =
-                    mesh.triangles().map(|t| t.map(DVec3::as_vec3)).collect();
-                let subdivision = RtwSubdivision::default().with_resolution(self.side);
-                let mut pieces = Vec::new();
-                subdivide_for_rtw(&shadow, &triangles, &subdivision, &mut pieces);
-                let mut fine = Mesh::new();
-                for t in &pieces {
-                    fine.push_triangle(t.map(Vec3::as_dvec3));
-                }
-                rasterize_depth(&fine, &RtwProjector::from(shadow), &options)
-            }
-            Inner::Paraboloid(map) => self.rasterize_paraboloid(map, mesh, &options),
+            _ => Err(fail(self.kind, &"no depth pass for this result")),
         }
     }
 
     fn rasterize_paraboloid(
         &self,
-        map: &ParaboloidMap,
+        map: &shadowmap::paraboloid::ParaboloidMap,
         mesh: &Mesh,
         options: &RasterOptions,
     ) -> Result<DepthMap, EvalError> {
+        let side = self.shadow.layer_side();
+        let layers = self.layers();
         let triangles: Vec<[Vec3; 3]> = mesh.triangles().map(|t| t.map(DVec3::as_vec3)).collect();
-        let sub = SubdivisionOptions::default().with_resolution(self.side);
-        let mut out = DepthMap::cleared(self.side, self.side, self.layers, map.reversed_z)?;
-        let per_layer = self.side as usize * self.side as usize;
+        let sub = SubdivisionOptions::default().with_resolution(side);
+        let mut out = DepthMap::cleared(side, side, layers, map.reversed_z)?;
+        let per_layer = side as usize * side as usize;
         let mut pieces = Vec::new();
-        for layer in 0..self.layers {
-            let side = if layer == 0 { Side::Front } else { Side::Back };
-            subdivide_triangles(map, side, &triangles, &sub, &mut pieces)
+        for layer in 0..layers {
+            let which = if layer == 0 { Side::Front } else { Side::Back };
+            subdivide_triangles(map, which, &triangles, &sub, &mut pieces)
                 .map_err(|x| fail(self.kind, &x))?;
-            let mut fine = Mesh::new();
-            for t in &pieces {
-                fine.push_triangle(t.map(Vec3::as_dvec3));
-            }
             let one = OneLayer {
                 inner: ParaboloidProjector::from(map),
                 layer,
             };
-            let d = rasterize_depth(&fine, &one, options)?;
+            let d = rasterize_depth(&mesh_of(&pieces), &one, options)?;
             let at = layer as usize * per_layer;
             out.depth[at..at + per_layer].copy_from_slice(&d.depth);
         }
         Ok(out)
     }
+}
+
+/// A mesh of `f32` triangles.
+fn mesh_of(triangles: &[[Vec3; 3]]) -> Mesh {
+    let mut mesh = Mesh::new();
+    for t in triangles {
+        mesh.push_triangle(t.map(Vec3::as_dvec3));
+    }
+    mesh
 }
 
 /// One layer of a projector, as layer 0.
@@ -637,93 +454,8 @@ impl<P: DepthProjector> DepthProjector for OneLayer<P> {
     }
 }
 
-fn point_of(light: &Light) -> Option<(Vec3, f32)> {
-    match *light {
-        Light::Point { position, range }
-        | Light::Spot {
-            position, range, ..
-        } => Some((position, range)),
-        Light::Directional { .. } => None,
-    }
-}
-
-/// Ladder step of the stable cascades' sizes: a rung every half octave.
-const STABLE_SIZE_STEP: f32 = core::f32::consts::SQRT_2;
-
-/// Splits of the cascaded matrix techniques: practical splits of the eye's depth
-/// bounds (the camera's range without samples), so no cascade covers empty depth.
-/// The count follows the bounds' ratio `r = max / min`: with `k` maps sharing the
-/// budget, a logarithmic split leaves each cascade a depth ratio `r^(1/k)` on
-/// `side(k)` texels, so the count minimizing `r^(1/k) / side(k)` is taken, among the
-/// counts up to `options.cascades` whose side is a power of two when there are any
-/// (the stable fit's whole-texel motion is exact in `f32` only there).
-fn cascade_splits(
-    camera: &Camera,
-    samples: &[EyeSample],
-    options: &TechniqueOptions,
-) -> Result<CascadeSplits, shadowmap_frustum::FrustumError> {
-    let (near, far) = match depth_bounds(camera, samples) {
-        Some(bounds) => bounds.clamped_to(camera)?,
-        None => camera.depth_range()?,
-    };
-    let ratio = f64::from(far) / f64::from(near);
-    let max = options.cascades.clamp(1, shadowmap_frustum::MAX_CASCADES);
-    let power_of_two = |k: &usize| options.layer_side(*k as u32).is_power_of_two();
-    let any_power = (1..=max).any(|k| power_of_two(&k));
-    let cost = |k: usize| ratio.powf(1.0 / k as f64) / f64::from(options.layer_side(k as u32));
-    let count = (1..=max)
-        .filter(|k| !any_power || power_of_two(k))
-        .min_by(|a, b| cost(*a).total_cmp(&cost(*b)))
-        .unwrap_or(1);
-    CascadeSplits::new(
-        &SplitScheme::Practical {
-            lambda: options.split_lambda,
-        },
-        count,
-        near,
-        far,
-    )
-}
-
-/// Min/max view depth of the eye's samples (IPSM's truncated frustum), `None`
-/// without samples.
-fn depth_bounds(camera: &Camera, samples: &[EyeSample]) -> Option<DepthBounds> {
-    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    for s in samples {
-        let d = camera.view_depth(s.position);
-        if d.is_finite() {
-            lo = lo.min(d);
-            hi = hi.max(d);
-        }
-    }
-    (lo < hi).then_some(DepthBounds { min: lo, max: hi })
-}
-
 impl ShadowMapping for Technique {
     fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
-        match &self.inner {
-            Inner::Matrix(t) => t.map_point(world),
-            Inner::Cascades(set) => set.map_point(world),
-            Inner::Warped {
-                eye,
-                forward,
-                cascades,
-            } => {
-                let depth = (world - *eye).dot(*forward);
-                let (i, (_, t)) = cascades
-                    .iter()
-                    .enumerate()
-                    .find(|(_, ((n, f), _))| depth >= *n && depth <= *f)?;
-                let mut s = t.as_ref()?.map_point(world)?;
-                s.layer = u32::try_from(i).ok()?;
-                Some(s)
-            }
-            Inner::Paraboloid(map) => map.map_point(world),
-            Inner::Rtw { base, warps } => RtwShadow {
-                base: *base,
-                warps: warps.as_ref(),
-            }
-            .map_point(world),
-        }
+        self.shadow.map_point(world)
     }
 }

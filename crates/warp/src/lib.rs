@@ -155,6 +155,7 @@ mod lispsm;
 mod serde_impls;
 mod tsm;
 mod uniform;
+mod warped_mapping;
 mod xpsm;
 
 pub use cascades::{WarpedCascade, WarpedCascades, warped_cascades};
@@ -165,6 +166,7 @@ pub use shadowmap_frustum::SceneBounds;
 pub use shadowmap_frustum::{ShadowTransform, glam};
 pub use tsm::{TsmOptions, TsmShadow, tsm};
 pub use uniform::{UniformOptions, uniform_focused};
+pub use warped_mapping::WarpedCascadesView;
 pub use xpsm::{XpsmOptions, XpsmShadow, xpsm};
 
 use glam::{Mat4, Vec3};

@@ -6,12 +6,9 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
-use shadowmap_frustum::{
-    Aabb, Camera, CascadeOptions, CascadeSet, CascadeSplits, Projection, SplitScheme,
-};
-use shadowmap_paraboloid::{MapOptions, ParaboloidMap};
+use shadowmap::{DpsmOptions, FitInput, Fitted, Shadow, Technique, fit};
+use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds};
 use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
-use shadowmap_warp::{SceneBounds, UniformOptions, XpsmOptions, uniform_focused, xpsm};
 use shadowmap_wgpu::GpuContext;
 use shadowmap_wgpu::depth::{
     DepthPassDesc, DepthTechnique, DepthUniforms, MeshBuffers, RtwSubdivision, ShadowDepthPass,
@@ -29,28 +26,45 @@ fn camera() -> Camera {
     .expect("camera")
 }
 
-fn packing(c: &mut Criterion) {
+/// Fits a technique for the bench camera over a 400 m block, `1024²` per layer.
+fn fit_bench(technique: &Technique, light: &Light, layers: u64) -> Shadow {
     let cam = camera();
-    let light = Vec3::new(0.4, -1.0, 0.3);
     let scene = SceneBounds::whole(Aabb::new(
         Vec3::new(-200.0, 0.0, -200.0),
         Vec3::new(200.0, 60.0, 200.0),
     ));
-    let uniform =
-        uniform_focused(&cam, light, &scene, &UniformOptions::default()).expect("uniform");
-    let x = xpsm(&cam, light, &scene, &XpsmOptions::default()).expect("xpsm");
-    let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.7 }, 4, 0.5, 500.0)
-        .and_then(|s| s.with_overlap(0.1))
-        .expect("splits");
-    let set = CascadeSet::fit(&cam, light, &splits, &CascadeOptions::default()).expect("cascades");
-    let map = ParaboloidMap::dual(
-        Vec3::new(0.0, 10.0, 0.0),
-        Vec3::NEG_Y,
-        0.1,
-        300.0,
-        &MapOptions::default(),
+    fit(
+        technique,
+        &FitInput::new(&cam, light, scene, layers * 1024 * 1024),
     )
-    .expect("paraboloid");
+    .unwrap_or_else(|e| panic!("{}: {e}", technique.name()))
+}
+
+fn packing(c: &mut Criterion) {
+    let sun = Light::Directional {
+        direction: Vec3::new(0.4, -1.0, 0.3),
+    };
+    let uniform = fit_bench(&Technique::UniformFocused(Default::default()), &sun, 1);
+    let uniform = *uniform.transform().expect("uniform");
+    let xpsm = fit_bench(&Technique::Xpsm(Default::default()), &sun, 1);
+    let Fitted::Xpsm(x) = xpsm.fitted() else {
+        panic!("xpsm");
+    };
+    let cascades = fit_bench(&Technique::StableCascades(Default::default()), &sun, 4);
+    let Fitted::Cascades(set) = cascades.fitted() else {
+        panic!("cascades");
+    };
+    assert_eq!(set.cascades.len(), 4);
+    let lamp = Light::Point {
+        position: Vec3::new(0.0, 10.0, 0.0),
+        range: 300.0,
+    };
+    let dpsm = fit_bench(
+        &Technique::Dpsm(DpsmOptions::default().with_near(0.1)),
+        &lamp,
+        2,
+    );
+    let map = dpsm.paraboloid().expect("paraboloid");
     let mut importance = ImportanceMap::new(256, 256).expect("map");
     let _ = importance.splat(Vec2::new(0.5, 0.5), 1.0);
     let mut warps = WarpMaps::new(256, 256).expect("warps");
@@ -66,15 +80,15 @@ fn packing(c: &mut Criterion) {
     g.bench_function("uniform", |b| {
         b.iter(|| black_box(black_box(&uniform).to_raw()));
     });
-    g.bench_function("xpsm", |b| b.iter(|| black_box(black_box(&x).to_raw())));
+    g.bench_function("xpsm", |b| b.iter(|| black_box(black_box(x).to_raw())));
     g.bench_function("cascades_lookup_4", |b| {
-        b.iter(|| black_box(black_box(&set).to_raw()));
+        b.iter(|| black_box(black_box(set).to_raw()));
     });
     g.bench_function("cascades_layers_4", |b| {
-        b.iter(|| black_box(cascade_layers(black_box(&set))));
+        b.iter(|| black_box(cascade_layers(black_box(set))));
     });
     g.bench_function("paraboloid_layers", |b| {
-        b.iter(|| black_box(paraboloid_layers(black_box(&map))));
+        b.iter(|| black_box(paraboloid_layers(black_box(map))));
     });
     g.bench_function("rtw_256", |b| {
         b.iter(|| {
@@ -126,7 +140,7 @@ fn packing(c: &mut Criterion) {
     let Ok(mesh) = MeshBuffers::from_triangles(&ctx, &ground) else {
         return;
     };
-    let layers = cascade_layers(&set);
+    let layers = cascade_layers(set);
     let desc = DepthPassDesc::new(DepthTechnique::Matrix, 1024).with_layers(layers.len() as u32);
     let Ok(mut pass) = ShadowDepthPass::new(&ctx, &desc) else {
         return;

@@ -146,6 +146,7 @@ pub use context::{BackendError, GpuContext};
 pub mod depth;
 pub mod profile;
 pub mod render;
+pub mod shadow;
 pub mod uniforms;
 
 // --- compute passes: depth reduction, RTW pipeline (another author) ---

@@ -2,22 +2,16 @@
 //! every technique: at most 0.1% of texels differ by more than 1e-4 in depth.
 
 use glam::{DVec3, Vec2, Vec3};
+use shadowmap::paraboloid::{Side, SubdivisionOptions, subdivide_triangles};
+use shadowmap::{CascadePlan, DpsmOptions, FitInput, Fitted, Shadow, Technique, fit};
 use shadowmap_eval::raster::{
     DepthMap, DepthProjector, MatrixProjector, ParaboloidProjector, RasterOptions, RtwProjector,
     rasterize_depth,
 };
 use shadowmap_eval::scene::{Mesh, Scene};
-use shadowmap_frustum::{
-    Camera, CascadeOptions, CascadeSet, CascadeSplits, Projection, ShadowTransform, SplitScheme,
-};
-use shadowmap_paraboloid::{
-    MapOptions, ParaboloidMap, Side, SubdivisionOptions, subdivide_triangles,
-};
+use shadowmap_frustum::{Camera, Light, Projection, ShadowTransform};
 use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
-use shadowmap_warp::{
-    LispsmOptions, SceneBounds, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
-    uniform_focused, xpsm,
-};
+use shadowmap_warp::{SceneBounds, UniformOptions};
 use shadowmap_wgpu::GpuContext;
 use shadowmap_wgpu::depth::{
     DepthPassDesc, DepthTechnique, DepthUniforms, MeshBuffers, RtwSubdivision, ShadowDepthPass,
@@ -59,6 +53,27 @@ fn mesh_of(tris: &[[Vec3; 3]]) -> Mesh {
 
 fn focus() -> SceneBounds {
     SceneBounds::whole(scene().bounds().unwrap())
+}
+
+/// Fits a technique for the test camera over the city block, `RES²` texels per layer
+/// (`layers` of them).
+fn fit_test(technique: &Technique, light: &Light, layers: u64) -> Shadow {
+    let camera = camera();
+    let budget = layers * u64::from(RES) * u64::from(RES);
+    let shadow = fit(technique, &FitInput::new(&camera, light, focus(), budget)).unwrap();
+    assert_eq!(shadow.layer_side(), RES);
+    shadow
+}
+
+fn sun() -> Light {
+    Light::Directional { direction: LIGHT }
+}
+
+/// The base fit of the RTW tests.
+fn uniform() -> ShadowTransform {
+    *fit_test(&Technique::UniformFocused(Default::default()), &sun(), 1)
+        .transform()
+        .unwrap()
 }
 
 /// Renders `tris` on the GPU and the CPU and returns (differing texels, total).
@@ -184,24 +199,23 @@ fn matrix_techniques_match_the_cpu_rasterizer() {
     else {
         return;
     };
-    let cam = camera();
-    let f = focus();
-    let uniform = uniform_focused(&cam, LIGHT, &f, &UniformOptions::default()).unwrap();
-    matrix_case(&ctx, "uniform", &uniform, uniform.to_raw());
-    let reversed = uniform_focused(
-        &cam,
-        LIGHT,
-        &f,
-        &UniformOptions::default().with_reversed_z(true),
-    )
-    .unwrap();
-    matrix_case(&ctx, "uniform reversed-Z", &reversed, reversed.to_raw());
-    let l = lispsm(&cam, LIGHT, &f, &LispsmOptions::default()).unwrap();
-    matrix_case(&ctx, "lispsm", &l.transform, l.to_raw());
-    let x = xpsm(&cam, LIGHT, &f, &XpsmOptions::default()).unwrap();
-    matrix_case(&ctx, "xpsm", &x.transform, x.to_raw());
-    let t = tsm(&cam, LIGHT, &f, &TsmOptions::default()).unwrap();
-    matrix_case(&ctx, "tsm", &t.transform, t.to_raw());
+    let reversed = UniformOptions::default().with_reversed_z(true);
+    for (name, technique) in [
+        ("uniform", Technique::UniformFocused(Default::default())),
+        ("uniform reversed-Z", Technique::UniformFocused(reversed)),
+        ("lispsm", Technique::Lispsm(Default::default())),
+        ("xpsm", Technique::Xpsm(Default::default())),
+        ("tsm", Technique::Tsm(Default::default())),
+    ] {
+        let shadow = fit_test(&technique, &sun(), 1);
+        let t = shadow.transform().unwrap();
+        // XPSM's block carries its Z bias scale.
+        let raw = match shadow.fitted() {
+            Fitted::Xpsm(x) => x.to_raw(),
+            _ => t.to_raw(),
+        };
+        matrix_case(&ctx, name, t, raw);
+    }
 }
 
 #[test]
@@ -211,28 +225,22 @@ fn cascades_render_one_layer_each_and_match() {
     else {
         return;
     };
-    let cam = camera();
-    let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.7 }, 3, 1.0, 300.0)
-        .unwrap()
-        .with_overlap(0.1)
-        .unwrap();
-    let set = CascadeSet::fit(
-        &cam,
-        LIGHT,
-        &splits,
-        &CascadeOptions::default()
-            .with_resolution(RES)
-            .with_scene(scene().scene_bounds()),
-    )
-    .unwrap();
-    let layers = cascade_layers(&set);
+    let plan = CascadePlan::default()
+        .with_max_cascades(3)
+        .with_split_lambda(0.7);
+    let shadow = fit_test(&Technique::TightCascades(plan), &sun(), 3);
+    let Fitted::Cascades(set) = shadow.fitted() else {
+        panic!("cascades expected");
+    };
+    let layers = cascade_layers(set);
+    assert_eq!(layers.len(), 3);
     let desc = DepthPassDesc::new(DepthTechnique::Matrix, RES).with_layers(3);
     let result = compare(
         &ctx,
         desc,
         &[triangles(&scene().mesh)],
         &DepthUniforms::Matrix(&layers),
-        &MatrixProjector::from(&set),
+        &MatrixProjector::from(set),
     );
     assert_close("cascades", result.0, result.1);
 }
@@ -244,29 +252,30 @@ fn paraboloid_front_and_back_match() {
     };
     // A point light among the buildings, front paraboloid facing down: the back side
     // sees the tall buildings' upper floors.
-    let map = ParaboloidMap::dual(
-        Vec3::new(3.0, 30.0, -2.0),
-        Vec3::new(0.2, -1.0, 0.1),
-        0.5,
-        400.0,
-        &MapOptions::default(),
-    )
-    .unwrap();
+    let lamp = Light::Point {
+        position: Vec3::new(3.0, 30.0, -2.0),
+        range: 400.0,
+    };
+    let dpsm = DpsmOptions::default()
+        .with_axis(Vec3::new(0.2, -1.0, 0.1))
+        .with_near(0.5);
+    let shadow = fit_test(&Technique::Dpsm(dpsm), &lamp, 2);
+    let map = shadow.paraboloid().unwrap();
     let tris = triangles(&scene().mesh);
     let options = SubdivisionOptions::default().with_resolution(RES);
     let mut front = Vec::new();
     let mut back = Vec::new();
-    subdivide_triangles(&map, Side::Front, &tris, &options, &mut front).unwrap();
-    subdivide_triangles(&map, Side::Back, &tris, &options, &mut back).unwrap();
+    subdivide_triangles(map, Side::Front, &tris, &options, &mut front).unwrap();
+    subdivide_triangles(map, Side::Back, &tris, &options, &mut back).unwrap();
     assert!(front.len() > tris.len(), "subdivision split something");
-    let layers = paraboloid_layers(&map);
+    let layers = paraboloid_layers(map);
     let desc = DepthPassDesc::new(DepthTechnique::Paraboloid, RES).with_layers(2);
     let (differing, total, cpu) = compare(
         &ctx,
         desc,
         &[front, back],
         &DepthUniforms::Paraboloid(&layers),
-        &ParaboloidProjector::from(&map),
+        &ParaboloidProjector::from(map),
     );
     // The hemisphere clip left the outside of the unit disc empty in both layers.
     let corner = cpu.get(0, 2, 2);
@@ -289,7 +298,7 @@ fn rtw_matches_with_warped_vertices() {
     else {
         return;
     };
-    let base = uniform_focused(&camera(), LIGHT, &focus(), &UniformOptions::default()).unwrap();
+    let base = uniform();
     let mut importance = ImportanceMap::new(64, 48).unwrap();
     importance.splat(Vec2::new(0.5, 0.6), 10.0).unwrap();
     importance.splat(Vec2::new(0.3, 0.2), 3.0).unwrap();
@@ -347,7 +356,7 @@ fn bad_inputs_are_typed_errors() {
     .unwrap();
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     // One block for a two-layer pass.
-    let t = uniform_focused(&camera(), LIGHT, &focus(), &UniformOptions::default()).unwrap();
+    let t = uniform();
     assert!(
         pass.encode(
             &ctx,
@@ -412,7 +421,7 @@ fn rtw_depth_pass_with_gpu_built_tables_matches_cpu_tables() {
         return;
     };
     let (width, height) = (64u32, 48u32);
-    let base = uniform_focused(&camera(), LIGHT, &focus(), &UniformOptions::default()).unwrap();
+    let base = uniform();
     let warp_options = WarpOptions::default().with_blur_radius(2);
     let importance_options = ImportanceOptions::default();
     let samples = eye_samples(&base, width, height);

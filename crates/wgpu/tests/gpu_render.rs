@@ -4,23 +4,21 @@
 //! passes use the same slope-scaled and constant rasterizer bias (no clamp: the
 //! reference has none).
 
-use glam::{DMat4, DVec3, DVec4, Vec2, Vec3};
+use glam::{DMat4, DVec3, DVec4, Vec3};
+use shadowmap::paraboloid::{IpsmOptions, Side, subdivide_triangles};
+use shadowmap::rtw::{EyeSample, WarpOptions};
+use shadowmap::{CascadePlan, DpsmOptions, FitInput, RtwPlan, Shadow, Technique, fit};
 use shadowmap_eval::raster::{
     DepthMap, DepthProjector, MatrixProjector, ParaboloidProjector, RasterOptions, RtwProjector,
     rasterize_depth,
 };
 use shadowmap_eval::scene::Mesh;
-use shadowmap_frustum::{
-    Aabb, Camera, CascadeOptions, CascadeSet, CascadeSplits, Projection, ShadowMapping, SplitScheme,
-};
-use shadowmap_paraboloid::{MapOptions, ParaboloidMap, Side, subdivide_triangles};
-use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
-use shadowmap_warp::{SceneBounds, UniformOptions, XpsmOptions, uniform_focused, xpsm};
+use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds, ShadowMapping};
+use shadowmap_warp::UniformOptions;
 use shadowmap_wgpu::GpuContext;
 use shadowmap_wgpu::depth::{DepthBias, subdivide_for_rtw};
 use shadowmap_wgpu::render::{
     HeadlessRenderer, MaskValue, RenderOptions, ShadowBias, ShadowFilter, ShadowMask,
-    ShadowTechnique,
 };
 
 const W: u32 = 160;
@@ -54,6 +52,49 @@ fn scene() -> Vec<[Vec3; 3]> {
 
 fn bounds() -> Aabb {
     Aabb::new(Vec3::new(-30.0, 0.0, -30.0), Vec3::new(30.0, 7.0, 30.0))
+}
+
+fn sun() -> Light {
+    Light::Directional { direction: LIGHT }
+}
+
+/// Fits a technique for the test camera over the test scene's bounds, `RES²` texels
+/// per layer (`layers` of them).
+fn fit_test(technique: &Technique, light: &Light, layers: u64, samples: &[EyeSample]) -> Shadow {
+    let camera = camera();
+    let budget = layers * u64::from(RES) * u64::from(RES);
+    let input = FitInput::new(&camera, light, SceneBounds::whole(bounds()), budget)
+        .with_eye_samples(samples);
+    let shadow = fit(technique, &input).unwrap();
+    assert_eq!(shadow.layer_side(), RES);
+    shadow
+}
+
+/// The surfaces a 40 x 30 grid of primary rays sees (RTW's eye samples).
+fn eye_samples(tris: &[[Vec3; 3]]) -> Vec<EyeSample> {
+    let world_from_clip: DMat4 = camera().clip_from_world().unwrap().as_dmat4().inverse();
+    let eye = camera().eye().as_dvec3();
+    let mut out = Vec::new();
+    for y in 0..30 {
+        for x in 0..40 {
+            let ndc = DVec4::new(
+                (f64::from(x) + 0.5) / 20.0 - 1.0,
+                1.0 - (f64::from(y) + 0.5) / 15.0,
+                1.0,
+                1.0,
+            );
+            let far = world_from_clip * ndc;
+            let dir = (far.truncate() / far.w - eye).normalize();
+            if let Some(p) = cast(tris, eye, dir) {
+                out.push(EyeSample {
+                    position: p.as_vec3(),
+                    normal: Vec3::ZERO,
+                    eye_distance: p.distance(eye) as f32,
+                });
+            }
+        }
+    }
+    out
 }
 
 fn camera() -> Camera {
@@ -181,11 +222,11 @@ fn assert_masks_agree(name: &str, gpu: &ShadowMask, cpu: &[Option<bool>]) {
 fn render(
     ctx: &GpuContext,
     renderer: &mut HeadlessRenderer,
-    technique: &ShadowTechnique<'_>,
+    shadow: &Shadow,
     options: &RenderOptions,
 ) -> ShadowMask {
     renderer
-        .render(ctx, &scene(), &camera(), technique, options)
+        .render_shadow(ctx, &scene(), &camera(), shadow, options)
         .expect("render")
         .mask
 }
@@ -199,74 +240,31 @@ fn matrix_and_cascade_masks_match_the_cpu_reference() {
     };
     let mut renderer = HeadlessRenderer::new();
     let tris = scene();
-    let focus = SceneBounds::whole(bounds());
+    let reversed = UniformOptions::default().with_reversed_z(true);
+    for (name, technique) in [
+        ("uniform", Technique::UniformFocused(Default::default())),
+        ("uniform reversed-Z", Technique::UniformFocused(reversed)),
+        ("xpsm", Technique::Xpsm(Default::default())),
+    ] {
+        let shadow = fit_test(&technique, &sun(), 1, &[]);
+        let gpu = render(&ctx, &mut renderer, &shadow, &options());
+        let projector = MatrixProjector::from(shadow.transform().unwrap());
+        let cpu = cpu_mask(&tris, &shadow, &cpu_depth(&tris, &projector));
+        assert_masks_agree(name, &gpu, &cpu);
+    }
 
-    let uniform = uniform_focused(&camera(), LIGHT, &focus, &UniformOptions::default()).unwrap();
-    let gpu = render(
-        &ctx,
-        &mut renderer,
-        &ShadowTechnique::Matrix(&uniform),
-        &options(),
-    );
+    let plan = CascadePlan::default().with_max_cascades(3);
+    let shadow = fit_test(&Technique::StableCascades(plan), &sun(), 3, &[]);
+    let shadowmap::Fitted::Cascades(set) = shadow.fitted() else {
+        panic!("cascades expected");
+    };
+    assert!(shadow.layers() > 1);
+    let gpu = render(&ctx, &mut renderer, &shadow, &options());
     let cpu = cpu_mask(
         &tris,
-        &uniform,
-        &cpu_depth(&tris, &MatrixProjector::from(&uniform)),
+        &shadow,
+        &cpu_depth(&tris, &MatrixProjector::from(set)),
     );
-    assert_masks_agree("uniform", &gpu, &cpu);
-
-    let reversed = uniform_focused(
-        &camera(),
-        LIGHT,
-        &focus,
-        &UniformOptions::default().with_reversed_z(true),
-    )
-    .unwrap();
-    let gpu = render(
-        &ctx,
-        &mut renderer,
-        &ShadowTechnique::Matrix(&reversed),
-        &options(),
-    );
-    let cpu = cpu_mask(
-        &tris,
-        &reversed,
-        &cpu_depth(&tris, &MatrixProjector::from(&reversed)),
-    );
-    assert_masks_agree("uniform reversed-Z", &gpu, &cpu);
-
-    let x = xpsm(&camera(), LIGHT, &focus, &XpsmOptions::default()).unwrap();
-    let gpu = render(&ctx, &mut renderer, &ShadowTechnique::Xpsm(&x), &options());
-    let cpu = cpu_mask(
-        &tris,
-        &x.transform,
-        &cpu_depth(&tris, &MatrixProjector::from(&x.transform)),
-    );
-    assert_masks_agree("xpsm", &gpu, &cpu);
-
-    let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.8 }, 3, 0.5, 120.0)
-        .unwrap()
-        .with_overlap(0.1)
-        .unwrap();
-    let set = CascadeSet::fit(
-        &camera(),
-        LIGHT,
-        &splits,
-        &CascadeOptions::default()
-            .with_resolution(RES)
-            .with_scene(Some(shadowmap_frustum::SceneBounds {
-                receivers: bounds(),
-                casters: bounds(),
-            })),
-    )
-    .unwrap();
-    let gpu = render(
-        &ctx,
-        &mut renderer,
-        &ShadowTechnique::Cascades(&set),
-        &options(),
-    );
-    let cpu = cpu_mask(&tris, &set, &cpu_depth(&tris, &MatrixProjector::from(&set)));
     assert_masks_agree("cascades", &gpu, &cpu);
 }
 
@@ -280,65 +278,59 @@ fn paraboloid_and_rtw_masks_match_the_cpu_reference() {
     let mut renderer = HeadlessRenderer::new();
     let tris = scene();
 
-    let map = ParaboloidMap::dual(
-        Vec3::new(1.0, 9.0, 1.0),
-        Vec3::new(0.1, -1.0, 0.0),
-        0.2,
-        80.0,
-        &MapOptions::default(),
-    )
-    .unwrap();
-    let gpu = render(
-        &ctx,
-        &mut renderer,
-        &ShadowTechnique::Paraboloid(&map),
-        &options(),
-    );
+    let lamp = Light::Point {
+        position: Vec3::new(1.0, 9.0, 1.0),
+        range: 80.0,
+    };
+    let dpsm = DpsmOptions::default()
+        .with_axis(Vec3::new(0.1, -1.0, 0.0))
+        .with_near(0.2);
+    let shadow = fit_test(&Technique::Dpsm(dpsm), &lamp, 2, &[]);
+    let map = shadow.paraboloid().unwrap();
+    let gpu = render(&ctx, &mut renderer, &shadow, &options());
     // The CPU map from the same subdivided casters, side by side.
     let sub = options().subdivision.with_resolution(RES);
     let mut depth = DepthMap::cleared(RES, RES, 2, false).unwrap();
     let n = (RES * RES) as usize;
     for (layer, side) in [Side::Front, Side::Back].into_iter().enumerate() {
         let mut out = Vec::new();
-        subdivide_triangles(&map, side, &tris, &sub, &mut out).unwrap();
-        let full = cpu_depth(&out, &ParaboloidProjector::from(&map));
+        subdivide_triangles(map, side, &tris, &sub, &mut out).unwrap();
+        let full = cpu_depth(&out, &ParaboloidProjector::from(map));
         depth.depth[layer * n..(layer + 1) * n]
             .copy_from_slice(&full.depth[layer * n..(layer + 1) * n]);
     }
-    let cpu = cpu_mask(&tris, &map, &depth);
+    let cpu = cpu_mask(&tris, &shadow, &depth);
     assert_masks_agree("paraboloid", &gpu, &cpu);
-
-    let base = uniform_focused(
-        &camera(),
-        LIGHT,
-        &SceneBounds::whole(bounds()),
-        &UniformOptions::default(),
+    // IPSM goes through the same match (a single or dual map).
+    let ipsm = fit(
+        &Technique::Ipsm(IpsmOptions::default()),
+        &FitInput::new(
+            &camera(),
+            &lamp,
+            SceneBounds::whole(bounds()),
+            u64::from(RES * RES),
+        ),
     )
     .unwrap();
-    let mut importance = ImportanceMap::new(32, 32).unwrap();
-    importance.splat(Vec2::new(0.5, 0.5), 5.0).unwrap();
-    importance.splat(Vec2::new(0.3, 0.6), 2.0).unwrap();
-    let mut warps = WarpMaps::new(32, 32).unwrap();
-    warps
-        .build(&importance, &WarpOptions::default().with_blur_radius(3))
+    let frame = renderer
+        .render_shadow(&ctx, &tris, &camera(), &ipsm, &options())
         .unwrap();
-    let shadow = RtwShadow {
-        base,
-        warps: &warps,
-    };
-    let gpu = render(
-        &ctx,
-        &mut renderer,
-        &ShadowTechnique::Rtw(&shadow),
-        &options(),
-    );
+    assert_eq!(frame.mask.values.len(), (W * H) as usize);
+
+    let plan = RtwPlan::default()
+        .with_importance_side(32)
+        .with_warp(WarpOptions::default().with_blur_radius(3));
+    let samples = eye_samples(&tris);
+    let shadow = fit_test(&Technique::Rtw(plan), &sun(), 1, &samples);
+    let rtw = shadow.rtw().unwrap();
+    let gpu = render(&ctx, &mut renderer, &shadow, &options());
     let mut casters = Vec::new();
     let sub = options().rtw_subdivision.with_resolution(RES);
-    subdivide_for_rtw(&shadow, &tris, &sub, &mut casters);
+    subdivide_for_rtw(&rtw, &tris, &sub, &mut casters);
     let cpu = cpu_mask(
         &tris,
         &shadow,
-        &cpu_depth(&casters, &RtwProjector::from(shadow)),
+        &cpu_depth(&casters, &RtwProjector::from(rtw)),
     );
     assert_masks_agree("rtw", &gpu, &cpu);
 }
@@ -351,13 +343,12 @@ fn every_filter_renders_and_png_round_trips() {
         return;
     };
     let mut renderer = HeadlessRenderer::new();
-    let uniform = uniform_focused(
-        &camera(),
-        LIGHT,
-        &SceneBounds::whole(bounds()),
-        &UniformOptions::default(),
-    )
-    .unwrap();
+    let uniform = fit_test(
+        &Technique::UniformFocused(Default::default()),
+        &sun(),
+        1,
+        &[],
+    );
     let mut brightness = Vec::new();
     for filter in [
         ShadowFilter::Hard,
@@ -370,11 +361,11 @@ fn every_filter_renders_and_png_round_trips() {
         ShadowFilter::Vsm { blur_radius: 2 },
     ] {
         let frame = renderer
-            .render(
+            .render_shadow(
                 &ctx,
                 &scene(),
                 &camera(),
-                &ShadowTechnique::Matrix(&uniform),
+                &uniform,
                 &options().with_filter(filter),
             )
             .unwrap_or_else(|e| panic!("{filter:?}: {e}"));
@@ -411,33 +402,61 @@ fn bad_render_input_is_a_typed_error() {
         return;
     };
     let mut renderer = HeadlessRenderer::new();
-    let uniform = uniform_focused(
-        &camera(),
-        LIGHT,
-        &SceneBounds::whole(bounds()),
-        &UniformOptions::default(),
-    )
+    let t = fit_test(
+        &Technique::UniformFocused(Default::default()),
+        &sun(),
+        1,
+        &[],
+    );
+    assert!(
+        renderer
+            .render_shadow(&ctx, &[], &camera(), &t, &options())
+            .is_err()
+    );
+    assert!(
+        renderer
+            .render_shadow(&ctx, &scene(), &camera(), &t, &options().with_size(0, 10))
+            .is_err()
+    );
+    let zero = options().with_shadow_resolution(0);
+    let direct = shadowmap_wgpu::shadow::with_technique(&t, |technique| {
+        renderer.render(&ctx, &scene(), &camera(), technique, &zero)
+    })
     .unwrap();
-    let t = ShadowTechnique::Matrix(&uniform);
-    assert!(
-        renderer
-            .render(&ctx, &[], &camera(), &t, &options())
-            .is_err()
+    assert!(direct.is_err());
+}
+
+#[test]
+fn warped_cascade_mask_through_fit_matches_the_cpu_reference() {
+    let Some(ctx) = shadowmap_wgpu::context::test_context(
+        "warped_cascade_mask_through_fit_matches_the_cpu_reference",
+    ) else {
+        return;
+    };
+    let mut renderer = HeadlessRenderer::new();
+    let tris = scene();
+    let shadow = fit_test(
+        &Technique::WarpedCascades {
+            plan: CascadePlan::default().with_max_cascades(2),
+            lispsm: Default::default(),
+        },
+        &sun(),
+        2,
+        &[],
     );
-    assert!(
-        renderer
-            .render(&ctx, &scene(), &camera(), &t, &options().with_size(0, 10))
-            .is_err()
+    let shadowmap::Fitted::WarpedCascades { cascades, .. } = shadow.fitted() else {
+        panic!("warped cascades expected");
+    };
+    let matrices = cascades
+        .cascades
+        .iter()
+        .map(|c| c.shadow.unwrap().transform.clip_from_world.as_dmat4())
+        .collect();
+    let gpu = render(&ctx, &mut renderer, &shadow, &options());
+    let cpu = cpu_mask(
+        &tris,
+        &shadow,
+        &cpu_depth(&tris, &MatrixProjector::new(matrices, false)),
     );
-    assert!(
-        renderer
-            .render(
-                &ctx,
-                &scene(),
-                &camera(),
-                &t,
-                &options().with_shadow_resolution(0)
-            )
-            .is_err()
-    );
+    assert_masks_agree("warped cascades", &gpu, &cpu);
 }

@@ -12,6 +12,22 @@ fn budget_is_shared_evenly() {
 }
 
 #[test]
+fn auto_candidates_are_the_umbrellas() {
+    let plan = CascadePlan::default();
+    let kinds: Vec<Option<TechniqueKind>> = shadowmap::auto_candidates(&plan)
+        .iter()
+        .map(TechniqueKind::of)
+        .collect();
+    let expected: Vec<Option<TechniqueKind>> = AUTO_CANDIDATES.iter().copied().map(Some).collect();
+    assert_eq!(kinds, expected);
+    // Every kind round-trips through the umbrella's value.
+    let o = TechniqueOptions::default();
+    for kind in TechniqueKind::ALL {
+        assert_eq!(TechniqueKind::of(&kind.technique(&o)), Some(kind));
+    }
+}
+
+#[test]
 fn every_light_has_techniques() {
     let d = Light::Directional {
         direction: Vec3::NEG_Y,
@@ -69,7 +85,7 @@ fn auto_is_the_candidate_with_the_lowest_prediction() {
         .collect();
     let candidates: Vec<(&dyn ShadowMapping, u32)> = fitted
         .iter()
-        .map(|t| (t as &dyn ShadowMapping, t.side))
+        .map(|t| (t as &dyn ShadowMapping, t.shadow().layer_side()))
         .collect();
     let mut predicted = vec![None; candidates.len()];
     predict_errors(

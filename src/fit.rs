@@ -1,0 +1,411 @@
+//! [`fit`]: one entry point for every technique, the same inputs for all.
+
+use alloc::vec::Vec;
+use core::fmt;
+
+use glam::Vec3;
+use shadowmap_frustum::math::{floor, powf, sqrt};
+use shadowmap_frustum::{
+    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, FrustumError,
+    Light, MAX_CASCADES, SceneBounds, SplitScheme, TechniqueSelector, fit_spot,
+};
+use shadowmap_paraboloid::{IpsmPlan, ParaboloidError, ParaboloidMap};
+use shadowmap_rtw::{EyeSample, ImportanceMap, OracleAxis, RtwError, WarpMaps};
+use shadowmap_warp::{
+    LispsmOptions, WarpError, lispsm, tsm, uniform_focused, warped_cascades, xpsm,
+};
+
+use crate::shadow::{Fitted, Shadow};
+use crate::technique::{CascadePlan, DpsmOptions, RtwPlan, Technique};
+
+/// What a technique may look at in one frame: the same for every technique.
+///
+/// Required: camera, light, scene bounds, texel budget. Optional, read only by the
+/// techniques that need them (see the crate docs' table):
+/// [`eye_samples`](Self::eye_samples) (RTW and the RTW oracle, required there),
+/// [`pixels_per_radian`](Self::pixels_per_radian) (RTW oracle, required there),
+/// [`depth_bounds`](Self::depth_bounds) (cascades, warped cascades, auto, IPSM; the
+/// camera's depth range without them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct FitInput<'a> {
+    /// The camera.
+    pub camera: &'a Camera,
+    /// The light.
+    pub light: &'a Light,
+    /// Receiver and caster bounds.
+    pub scene: SceneBounds,
+    /// Texels over all layers; each of `k` layers gets a square of side
+    /// `floor(sqrt(budget / k))` (at least 4).
+    pub texel_budget: u64,
+    /// The surfaces the eye sees (e.g. a G-buffer's visible pixels).
+    pub eye_samples: Option<&'a [EyeSample]>,
+    /// Min/max view depth of the visible surfaces (e.g. a depth reduction, or
+    /// [`depth_bounds_of`] the eye samples).
+    pub depth_bounds: Option<DepthBounds>,
+    /// Vertical focal length of the image in pixels.
+    pub pixels_per_radian: Option<f32>,
+}
+
+impl<'a> FitInput<'a> {
+    /// The inputs every technique needs, none of the optional ones.
+    #[must_use]
+    pub const fn new(
+        camera: &'a Camera,
+        light: &'a Light,
+        scene: SceneBounds,
+        texel_budget: u64,
+    ) -> Self {
+        Self {
+            camera,
+            light,
+            scene,
+            texel_budget,
+            eye_samples: None,
+            depth_bounds: None,
+            pixels_per_radian: None,
+        }
+    }
+    /// With the eye's visible surfaces.
+    #[must_use]
+    pub const fn with_eye_samples(mut self, samples: &'a [EyeSample]) -> Self {
+        self.eye_samples = Some(samples);
+        self
+    }
+    /// With measured depth bounds (`None`: the camera's range).
+    #[must_use]
+    pub const fn with_depth_bounds(mut self, bounds: Option<DepthBounds>) -> Self {
+        self.depth_bounds = bounds;
+        self
+    }
+    /// With the image's vertical focal length in pixels.
+    #[must_use]
+    pub const fn with_pixels_per_radian(mut self, pixels_per_radian: f32) -> Self {
+        self.pixels_per_radian = Some(pixels_per_radian);
+        self
+    }
+
+    /// Side of each of `layers` square maps sharing the budget ([`layer_side`]).
+    #[must_use]
+    pub fn layer_side(&self, layers: u32) -> u32 {
+        layer_side(self.texel_budget, layers)
+    }
+}
+
+/// Side of each of `layers` square maps sharing `texel_budget` texels:
+/// `floor(sqrt(budget / layers))`, at least 4.
+#[must_use]
+pub fn layer_side(texel_budget: u64, layers: u32) -> u32 {
+    let per = texel_budget / u64::from(layers.max(1));
+    (floor(sqrt(per as f64)) as u32).max(4)
+}
+
+/// Why [`fit`] refused a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum FitError {
+    /// The technique is for another kind of light.
+    WrongLight {
+        /// [`Technique::name`].
+        technique: &'static str,
+    },
+    /// A [`FitInput`] field the technique needs is `None`.
+    MissingInput {
+        /// [`Technique::name`].
+        technique: &'static str,
+        /// The field's name.
+        input: &'static str,
+    },
+    /// A zero texel budget.
+    InvalidBudget,
+    /// `auto`: no candidate could be fitted and predicted.
+    NoCandidate,
+    /// From `shadowmap-frustum` (cameras, lights, cascades, spot fit).
+    Frustum(FrustumError),
+    /// From `shadowmap-warp` (uniform, LiSPSM, XPSM, TSM, warped cascades).
+    Warp(WarpError),
+    /// From `shadowmap-paraboloid` (DPSM, IPSM).
+    Paraboloid(ParaboloidError),
+    /// From `shadowmap-rtw` (importance, warp tables).
+    Rtw(RtwError),
+}
+
+impl fmt::Display for FitError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::WrongLight { .. } => f.write_str("not for this kind of light"),
+            Self::MissingInput { input, .. } => write!(f, "missing input: {input}"),
+            Self::InvalidBudget => f.write_str("texel budget is zero"),
+            Self::NoCandidate => f.write_str("no candidate could be fitted"),
+            Self::Frustum(e) => e.fmt(f),
+            Self::Warp(e) => e.fmt(f),
+            Self::Paraboloid(e) => e.fmt(f),
+            Self::Rtw(e) => e.fmt(f),
+        }
+    }
+}
+
+impl core::error::Error for FitError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            Self::Frustum(e) => Some(e),
+            Self::Warp(e) => Some(e),
+            Self::Paraboloid(e) => Some(e),
+            Self::Rtw(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<FrustumError> for FitError {
+    fn from(e: FrustumError) -> Self {
+        Self::Frustum(e)
+    }
+}
+impl From<WarpError> for FitError {
+    fn from(e: WarpError) -> Self {
+        Self::Warp(e)
+    }
+}
+impl From<ParaboloidError> for FitError {
+    fn from(e: ParaboloidError) -> Self {
+        Self::Paraboloid(e)
+    }
+}
+impl From<RtwError> for FitError {
+    fn from(e: RtwError) -> Self {
+        Self::Rtw(e)
+    }
+}
+
+/// Fits `technique` to one frame. `auto` picks on this frame alone; a renderer that
+/// keeps its choice across frames uses [`fit_with_selector`].
+///
+/// # Errors
+/// [`FitError::WrongLight`] when the technique is for another kind of light;
+/// [`FitError::MissingInput`] when an input it needs is `None`;
+/// [`FitError::InvalidBudget`] for a zero budget; [`FitError::NoCandidate`] when no
+/// `auto` candidate fits; otherwise the builder's own error, wrapped.
+pub fn fit(technique: &Technique, input: &FitInput<'_>) -> Result<Shadow, FitError> {
+    fit_with_selector(technique, input, &mut TechniqueSelector::new())
+}
+
+/// [`fit`], with the caller's `selector` keeping `auto`'s choice across frames
+/// (hysteresis: it switches only when another candidate is predicted better by the
+/// selector's margin). Other techniques ignore the selector.
+///
+/// # Errors
+/// As [`fit`].
+pub fn fit_with_selector(
+    technique: &Technique,
+    input: &FitInput<'_>,
+    selector: &mut TechniqueSelector,
+) -> Result<Shadow, FitError> {
+    if !technique.applies_to(input.light) {
+        return Err(FitError::WrongLight {
+            technique: technique.name(),
+        });
+    }
+    if input.texel_budget == 0 {
+        return Err(FitError::InvalidBudget);
+    }
+    if let Technique::Auto(plan) = technique {
+        return crate::auto::fit_auto(plan, input, selector);
+    }
+    let (fitted, layers) = fit_one(technique, input)?;
+    Ok(Shadow {
+        requested: *technique,
+        technique: *technique,
+        fitted,
+        layers,
+        layer_side: input.layer_side(layers),
+    })
+}
+
+/// The result and layer count of every technique but `auto`.
+fn fit_one(technique: &Technique, input: &FitInput<'_>) -> Result<(Fitted, u32), FitError> {
+    let (camera, scene) = (input.camera, &input.scene);
+    let direction = match *input.light {
+        Light::Directional { direction } => direction,
+        _ => Vec3::ZERO,
+    };
+    Ok(match technique {
+        Technique::UniformFocused(o) => (
+            Fitted::Uniform(uniform_focused(camera, direction, scene, o)?),
+            1,
+        ),
+        Technique::Lispsm(o) => (Fitted::Lispsm(lispsm(camera, direction, scene, o)?), 1),
+        Technique::Xpsm(o) => (Fitted::Xpsm(xpsm(camera, direction, scene, o)?), 1),
+        Technique::Tsm(o) => (Fitted::Tsm(tsm(camera, direction, scene, o)?), 1),
+        Technique::StableCascades(plan) | Technique::TightCascades(plan) => {
+            let stable = matches!(technique, Technique::StableCascades(_));
+            fit_cascades(plan, stable, direction, input)?
+        }
+        Technique::WarpedCascades { plan, lispsm } => fit_warped(plan, lispsm, direction, input)?,
+        Technique::Rtw(plan) => (fit_rtw(plan, false, direction, input)?, 1),
+        Technique::RtwOracle(plan) => (fit_rtw(plan, true, direction, input)?, 1),
+        Technique::SpotFit { reversed_z } => {
+            let frustum = camera.frustum()?;
+            let s = fit_spot(input.light, &frustum, Some(scene), *reversed_z)?;
+            (Fitted::Spot(s), 1)
+        }
+        Technique::Dpsm(o) => (Fitted::Dpsm(fit_dpsm(o, input.light)?), 2),
+        Technique::Ipsm(o) => {
+            let plan = IpsmPlan::new(input.light, camera, input.depth_bounds, o)?;
+            let layers = plan.map.layers();
+            (Fitted::Ipsm(plan), layers)
+        }
+        // `fit_with_selector` handles `auto` before coming here.
+        Technique::Auto(_) => return Err(FitError::NoCandidate),
+    })
+}
+
+/// Ladder step of the stable cascades' sizes: a rung every half octave.
+const STABLE_SIZE_STEP: f32 = core::f32::consts::SQRT_2;
+
+fn fit_cascades(
+    plan: &CascadePlan,
+    stable: bool,
+    direction: Vec3,
+    input: &FitInput<'_>,
+) -> Result<(Fitted, u32), FitError> {
+    let splits = cascade_splits(plan, input)?;
+    let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
+    let fit = CascadeOptions::default()
+        .with_resolution(input.layer_side(layers))
+        .with_scene(Some(input.scene));
+    let fit = if stable {
+        fit.with_stable_size_step(Some(STABLE_SIZE_STEP))
+    } else {
+        fit.with_fit(CascadeFit::Tight)
+    };
+    let set = CascadeSet::fit(input.camera, direction, &splits, &fit)?;
+    Ok((Fitted::Cascades(set), layers))
+}
+
+fn fit_warped(
+    plan: &CascadePlan,
+    options: &LispsmOptions,
+    direction: Vec3,
+    input: &FitInput<'_>,
+) -> Result<(Fitted, u32), FitError> {
+    // The same split rule as the unwarped cascades: count and range from the depth
+    // bounds, so no cascade is spent on empty depth.
+    let splits = cascade_splits(plan, input)?;
+    let count = splits.count();
+    let etas = [options.eta; MAX_CASCADES];
+    let cascades = warped_cascades(
+        input.camera,
+        direction,
+        &input.scene,
+        &splits,
+        etas.get(..count).unwrap_or(&[]),
+        options,
+    )?;
+    let fitted = Fitted::WarpedCascades {
+        cascades,
+        eye: input.camera.eye(),
+        forward: input.camera.forward(),
+    };
+    Ok((fitted, u32::try_from(count).unwrap_or(u32::MAX)))
+}
+
+/// Splits of the cascaded techniques: practical splits of the depth bounds (the
+/// camera's range without them), so no cascade covers empty depth. The count follows
+/// the bounds' ratio `r = max / min`: with `k` maps sharing the budget, a
+/// logarithmic split leaves each cascade a depth ratio `r^(1/k)` on `side(k)` texels,
+/// so the count minimizing `r^(1/k) / side(k)` is taken, among the counts up to
+/// `plan.max_cascades` whose side is a power of two when there are any (the stable
+/// fit's whole-texel motion is exact in `f32` only there).
+fn cascade_splits(plan: &CascadePlan, input: &FitInput<'_>) -> Result<CascadeSplits, FitError> {
+    let camera = input.camera;
+    let (near, far) = match input.depth_bounds {
+        Some(bounds) => bounds.clamped_to(camera)?,
+        None => camera.depth_range()?,
+    };
+    let ratio = f64::from(far) / f64::from(near);
+    let max = plan.max_cascades.clamp(1, MAX_CASCADES);
+    let side = |k: usize| input.layer_side(u32::try_from(k).unwrap_or(u32::MAX));
+    let any_power = (1..=max).any(|k| side(k).is_power_of_two());
+    let cost = |k: usize| powf(ratio, 1.0 / k as f64) / f64::from(side(k));
+    let count = (1..=max)
+        .filter(|k| !any_power || side(*k).is_power_of_two())
+        .min_by(|a, b| cost(*a).total_cmp(&cost(*b)))
+        .unwrap_or(1);
+    let scheme = SplitScheme::Practical {
+        lambda: plan.split_lambda,
+    };
+    Ok(CascadeSplits::new(&scheme, count, near, far)?)
+}
+
+fn fit_rtw(
+    plan: &RtwPlan,
+    oracle: bool,
+    direction: Vec3,
+    input: &FitInput<'_>,
+) -> Result<Fitted, FitError> {
+    let name = if oracle { "rtw_oracle" } else { "rtw" };
+    let missing = |what| FitError::MissingInput {
+        technique: name,
+        input: what,
+    };
+    let samples = input.eye_samples.ok_or_else(|| missing("eye_samples"))?;
+    let camera = input.camera;
+    let base = uniform_focused(camera, direction, &input.scene, &Default::default())?;
+    let n = plan.importance_side;
+    let mut map = ImportanceMap::new(n, n)?;
+    let mut warps = WarpMaps::new(n, n)?;
+    if oracle {
+        let pixels_per_radian = input
+            .pixels_per_radian
+            .ok_or_else(|| missing("pixels_per_radian"))?;
+        // The oracle of a separable warp: each axis gets the density that axis needs
+        // (an isotropic requirement would spend texels on the axis that does not need
+        // them). Perspective-only (zero normal): true-normal requirements of surfaces
+        // seen edge-on are unbounded and, once normalized, starve the rest of the map.
+        let mut map_v = ImportanceMap::new(n, n)?;
+        let flat: Vec<EyeSample> = samples
+            .iter()
+            .map(|s| EyeSample {
+                normal: Vec3::ZERO,
+                ..*s
+            })
+            .collect();
+        for (axis, m) in [(OracleAxis::U, &mut map), (OracleAxis::V, &mut map_v)] {
+            m.accumulate_oracle_axis(axis, &base, camera, pixels_per_radian, &flat)?;
+        }
+        warps.build_separable(&map, &map_v, &plan.warp)?;
+    } else {
+        map.accumulate_backward(&base, samples, None, &plan.importance)?;
+        warps.build(&map, &plan.warp)?;
+    }
+    Ok(Fitted::Rtw { base, warps })
+}
+
+fn fit_dpsm(options: &DpsmOptions, light: &Light) -> Result<ParaboloidMap, FitError> {
+    let Light::Point { position, range } = *light else {
+        return Err(FitError::Paraboloid(ParaboloidError::UnsupportedLight));
+    };
+    Ok(ParaboloidMap::dual(
+        position,
+        options.axis,
+        options.near,
+        range,
+        &options.map,
+    )?)
+}
+
+/// Min/max view depth of eye samples (IPSM's truncated frustum, the cascades' split
+/// range), `None` without samples or when they span no depth.
+#[must_use]
+pub fn depth_bounds_of(camera: &Camera, samples: &[EyeSample]) -> Option<DepthBounds> {
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    for s in samples {
+        let d = camera.view_depth(s.position);
+        if d.is_finite() {
+            lo = lo.min(d);
+            hi = hi.max(d);
+        }
+    }
+    (lo < hi).then_some(DepthBounds { min: lo, max: hi })
+}

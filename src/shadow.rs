@@ -1,0 +1,175 @@
+//! [`Shadow`]: a fitted technique, owning the math crates' own result types.
+
+use glam::{DVec3, Vec3};
+use shadowmap_frustum::{CascadeSet, ShadowMapping, ShadowSample, ShadowTransform, SpotShadow};
+use shadowmap_paraboloid::{IpsmPlan, ParaboloidMap};
+use shadowmap_rtw::{RtwShadow, WarpMaps};
+use shadowmap_warp::{LispsmShadow, TsmShadow, WarpedCascades, WarpedCascadesView, XpsmShadow};
+
+use crate::Technique;
+
+/// The result of one fit, as the math crate that built it returns it.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+// Cascade sets and warped cascades keep their fixed-capacity arrays inline, so a fit
+// allocates nothing (RTW's tables aside); a `Shadow` is built once per frame.
+#[expect(
+    clippy::large_enum_variant,
+    reason = "inline cascades keep fitting allocation-free"
+)]
+pub enum Fitted {
+    /// Uniform focused (`shadowmap_warp::uniform_focused`).
+    Uniform(ShadowTransform),
+    /// Stable or tight cascades, one layer per cascade.
+    Cascades(CascadeSet),
+    /// LiSPSM.
+    Lispsm(LispsmShadow),
+    /// XPSM, with its warped-space Z bias.
+    Xpsm(XpsmShadow),
+    /// TSM.
+    Tsm(TsmShadow),
+    /// Warped cascades with the camera they were fitted for (selection by view
+    /// depth, see [`WarpedCascades::view`]).
+    WarpedCascades {
+        /// The cascades.
+        cascades: WarpedCascades,
+        /// The camera's eye.
+        eye: Vec3,
+        /// The camera's unit viewing direction.
+        forward: Vec3,
+    },
+    /// RTW and the RTW oracle: the base fit and the warp tables.
+    Rtw {
+        /// The uniform fit that is warped.
+        base: ShadowTransform,
+        /// The warp tables.
+        warps: WarpMaps,
+    },
+    /// The spot fit.
+    Spot(SpotShadow),
+    /// The dual paraboloid map.
+    Dpsm(ParaboloidMap),
+    /// The IPSM plan (its map is single or dual).
+    Ipsm(IpsmPlan),
+}
+
+/// A technique fitted to one frame by [`fit`](crate::fit): what was asked for, what
+/// was fitted (the candidate `auto` chose), the math crate's result, and the layers
+/// (cascades, paraboloid sides) of equal square size sharing the texel budget.
+///
+/// It is a [`ShadowMapping`]: world point to `(uv, depth, layer)`, the same lookup a
+/// shader does.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shadow {
+    pub(crate) requested: Technique,
+    pub(crate) technique: Technique,
+    pub(crate) fitted: Fitted,
+    pub(crate) layers: u32,
+    pub(crate) layer_side: u32,
+}
+
+impl Shadow {
+    /// The technique that was fitted: the one asked for, or for
+    /// [`Technique::Auto`] the candidate it chose.
+    #[must_use]
+    pub const fn technique(&self) -> &Technique {
+        &self.technique
+    }
+
+    /// The technique asked for (may be [`Technique::Auto`]).
+    #[must_use]
+    pub const fn requested(&self) -> &Technique {
+        &self.requested
+    }
+
+    /// The math crate's result.
+    #[must_use]
+    pub const fn fitted(&self) -> &Fitted {
+        &self.fitted
+    }
+
+    /// Number of layers: cascades, paraboloid sides, 1 for a single map.
+    #[must_use]
+    pub const fn layers(&self) -> u32 {
+        self.layers
+    }
+
+    /// Side in texels of each (square) layer.
+    #[must_use]
+    pub const fn layer_side(&self) -> u32 {
+        self.layer_side
+    }
+
+    /// Texels over all layers (at most the budget).
+    #[must_use]
+    pub const fn texels(&self) -> u64 {
+        self.layer_side as u64 * self.layer_side as u64 * self.layers as u64
+    }
+
+    /// The single matrix pair of a one-map matrix technique (uniform, LiSPSM, XPSM,
+    /// TSM, spot); `None` for cascades, paraboloids and RTW.
+    #[must_use]
+    pub const fn transform(&self) -> Option<&ShadowTransform> {
+        match &self.fitted {
+            Fitted::Uniform(t) => Some(t),
+            Fitted::Lispsm(s) => Some(&s.transform),
+            Fitted::Xpsm(s) => Some(&s.transform),
+            Fitted::Tsm(s) => Some(&s.transform),
+            Fitted::Spot(s) => Some(&s.transform),
+            _ => None,
+        }
+    }
+
+    /// The paraboloid map of DPSM and IPSM.
+    #[must_use]
+    pub const fn paraboloid(&self) -> Option<&ParaboloidMap> {
+        match &self.fitted {
+            Fitted::Dpsm(map) => Some(map),
+            Fitted::Ipsm(plan) => Some(&plan.map),
+            _ => None,
+        }
+    }
+
+    /// RTW's base fit and tables, borrowed as the rtw crate's [`RtwShadow`].
+    #[must_use]
+    pub const fn rtw(&self) -> Option<RtwShadow<'_>> {
+        match &self.fitted {
+            Fitted::Rtw { base, warps } => Some(RtwShadow { base: *base, warps }),
+            _ => None,
+        }
+    }
+
+    /// Warped cascades with their camera, as a mapping.
+    #[must_use]
+    pub const fn warped_cascades(&self) -> Option<WarpedCascadesView<'_>> {
+        match &self.fitted {
+            Fitted::WarpedCascades {
+                cascades,
+                eye,
+                forward,
+            } => Some(cascades.view(*eye, *forward)),
+            _ => None,
+        }
+    }
+}
+
+impl ShadowMapping for Shadow {
+    fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
+        match &self.fitted {
+            Fitted::Cascades(set) => set.map_point(world),
+            Fitted::WarpedCascades {
+                cascades,
+                eye,
+                forward,
+            } => cascades.view(*eye, *forward).map_point(world),
+            Fitted::Rtw { base, warps } => RtwShadow { base: *base, warps }.map_point(world),
+            Fitted::Dpsm(map) => map.map_point(world),
+            Fitted::Ipsm(plan) => plan.map.map_point(world),
+            Fitted::Uniform(t) => t.map_point(world),
+            Fitted::Lispsm(LispsmShadow { transform, .. })
+            | Fitted::Xpsm(XpsmShadow { transform, .. })
+            | Fitted::Tsm(TsmShadow { transform, .. })
+            | Fitted::Spot(SpotShadow { transform, .. }) => transform.map_point(world),
+        }
+    }
+}

@@ -1,0 +1,280 @@
+//! [`Technique`]: every shadow-map parameterization as a value, with its options.
+
+use glam::Vec3;
+use shadowmap_frustum::Light;
+use shadowmap_paraboloid::{ConeFit, IpsmOptions, MapOptions};
+use shadowmap_rtw::{ImportanceOptions, WarpOptions};
+use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
+
+/// A shadow technique with its options, chosen by value and fitted by
+/// [`fit`](crate::fit). Which light each one is for, and which optional
+/// [`FitInput`](crate::FitInput) fields it reads, is in the crate docs' table.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Technique {
+    /// Orthographic fit of frustum ∩ receivers, near plane pulled back to the casters
+    /// (`shadowmap_warp::uniform_focused`). Directional light.
+    UniformFocused(UniformOptions),
+    /// Parallel-split shadow maps (Zhang et al.), stable fit: rotation-invariant size
+    /// on a ladder of sizes, texel snapping, clipped to the receivers. Directional
+    /// light.
+    StableCascades(CascadePlan),
+    /// Parallel-split shadow maps, tight fit to slice ∩ receivers (SDSM-style).
+    /// Directional light.
+    TightCascades(CascadePlan),
+    /// Light space perspective shadow maps (Wimmer, Scherzer and Purgathofer).
+    /// Directional light.
+    Lispsm(LispsmOptions),
+    /// Extended perspective shadow maps (Gusev). Directional light.
+    Xpsm(XpsmOptions),
+    /// Trapezoidal shadow maps (Martin and Tan). Directional light.
+    Tsm(TsmOptions),
+    /// Parallel splits with a LiSPSM warp per cascade. Directional light.
+    WarpedCascades {
+        /// Split count and placement.
+        plan: CascadePlan,
+        /// The per-cascade warp (its `eta` is the strength of every cascade).
+        lispsm: LispsmOptions,
+    },
+    /// The candidate of [`auto_candidates`](crate::auto_candidates) (uniform,
+    /// LiSPSM, TSM, XPSM and the three cascaded techniques with this plan) with the
+    /// lowest error predicted from the camera, light and bounds alone, with
+    /// hysteresis across frames through a caller-held selector
+    /// ([`fit_with_selector`](crate::fit_with_selector)). Directional light.
+    Auto(CascadePlan),
+    /// Rectilinear texture warping (Rosen) over the uniform fit, importance from the
+    /// eye's samples (backward analysis). Directional light.
+    Rtw(RtwPlan),
+    /// RTW fed the exact perspective-only density each axis requires: the limit RTW
+    /// approaches. Directional light.
+    RtwOracle(RtwPlan),
+    /// Perspective fit of a spot light to frustum ∩ receivers, clamped to its cone.
+    SpotFit {
+        /// Reversed-Z depth.
+        reversed_z: bool,
+    },
+    /// Dual paraboloid shadow map (Brabec et al.), not view-dependent. Point light.
+    Dpsm(DpsmOptions),
+    /// Improved paraboloid shadow maps (Vanek et al.): truncated frustum, cone fit,
+    /// rotation, cut, single or dual; `fit` picks the paper's averaged cone or the
+    /// exact minimal cone. Point light.
+    Ipsm(IpsmOptions),
+}
+
+/// Splits of the cascaded techniques: practical splits (Zhang et al.) of the eye's
+/// depth bounds, the count chosen from their ratio (see the crate docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct CascadePlan {
+    /// Most cascades. Default 4 (clamped to `1..=MAX_CASCADES`).
+    pub max_cascades: usize,
+    /// Practical split weight (0 uniform, 1 logarithmic). Default 0.5.
+    pub split_lambda: f32,
+}
+
+impl Default for CascadePlan {
+    fn default() -> Self {
+        Self {
+            max_cascades: 4,
+            split_lambda: 0.5,
+        }
+    }
+}
+
+impl CascadePlan {
+    /// With at most this many cascades.
+    #[must_use]
+    pub const fn with_max_cascades(mut self, count: usize) -> Self {
+        self.max_cascades = count;
+        self
+    }
+    /// With this practical-split weight (1: logarithmic splits).
+    #[must_use]
+    pub const fn with_split_lambda(mut self, lambda: f32) -> Self {
+        self.split_lambda = lambda;
+        self
+    }
+}
+
+/// Knobs of RTW and the RTW oracle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct RtwPlan {
+    /// Side of the importance map and of the warp tables. Default 256.
+    pub importance_side: u32,
+    /// Backward analysis (RTW only).
+    pub importance: ImportanceOptions,
+    /// Blur, floor and normalization of the warp.
+    pub warp: WarpOptions,
+}
+
+impl Default for RtwPlan {
+    fn default() -> Self {
+        Self {
+            importance_side: 256,
+            importance: ImportanceOptions::default(),
+            warp: WarpOptions::default(),
+        }
+    }
+}
+
+impl RtwPlan {
+    /// With this importance-map side.
+    #[must_use]
+    pub const fn with_importance_side(mut self, side: u32) -> Self {
+        self.importance_side = side;
+        self
+    }
+    /// With these backward-analysis options.
+    #[must_use]
+    pub const fn with_importance(mut self, importance: ImportanceOptions) -> Self {
+        self.importance = importance;
+        self
+    }
+    /// With these warp options.
+    #[must_use]
+    pub const fn with_warp(mut self, warp: WarpOptions) -> Self {
+        self.warp = warp;
+        self
+    }
+}
+
+/// Knobs of the dual paraboloid map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct DpsmOptions {
+    /// The front map's axis (world). Default `-Y` (down).
+    pub axis: Vec3,
+    /// Distance from the light mapped to depth 0; the far distance is the light's
+    /// range. Default that of [`IpsmOptions`].
+    pub near: f32,
+    /// The map's other knobs.
+    pub map: MapOptions,
+}
+
+impl Default for DpsmOptions {
+    fn default() -> Self {
+        Self {
+            axis: Vec3::NEG_Y,
+            near: IpsmOptions::default().near,
+            map: MapOptions::default(),
+        }
+    }
+}
+
+impl DpsmOptions {
+    /// With this front axis.
+    #[must_use]
+    pub const fn with_axis(mut self, axis: Vec3) -> Self {
+        self.axis = axis;
+        self
+    }
+    /// With this near distance.
+    #[must_use]
+    pub const fn with_near(mut self, near: f32) -> Self {
+        self.near = near;
+        self
+    }
+    /// With these map options.
+    #[must_use]
+    pub const fn with_map(mut self, map: MapOptions) -> Self {
+        self.map = map;
+        self
+    }
+}
+
+/// Which kind of light a technique is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LightKind {
+    /// [`Light::Directional`].
+    Directional,
+    /// [`Light::Spot`].
+    Spot,
+    /// [`Light::Point`].
+    Point,
+}
+
+impl LightKind {
+    /// The kind of a light.
+    #[must_use]
+    pub const fn of(light: &Light) -> Self {
+        match light {
+            Light::Directional { .. } => Self::Directional,
+            Light::Spot { .. } => Self::Spot,
+            Light::Point { .. } => Self::Point,
+        }
+    }
+}
+
+impl Technique {
+    /// Every technique with default options, in report order.
+    #[must_use]
+    pub fn all_default() -> [Self; 14] {
+        let plan = CascadePlan::default();
+        let rtw = RtwPlan::default();
+        [
+            Self::UniformFocused(UniformOptions::default()),
+            Self::StableCascades(plan),
+            Self::TightCascades(plan),
+            Self::Lispsm(LispsmOptions::default()),
+            Self::Xpsm(XpsmOptions::default()),
+            Self::Tsm(TsmOptions::default()),
+            Self::WarpedCascades {
+                plan,
+                lispsm: LispsmOptions::default(),
+            },
+            Self::Auto(plan),
+            Self::Rtw(rtw),
+            Self::RtwOracle(rtw),
+            Self::SpotFit { reversed_z: false },
+            Self::Dpsm(DpsmOptions::default()),
+            Self::Ipsm(IpsmOptions::default().with_fit(ConeFit::Paper)),
+            Self::Ipsm(IpsmOptions::default().with_fit(ConeFit::Exact)),
+        ]
+    }
+
+    /// Short identifier for tables, logs and file names (`"uniform"`, `"lispsm"`,
+    /// `"ipsm_exact"`, ...).
+    #[must_use]
+    pub const fn name(&self) -> &'static str {
+        match self {
+            Self::UniformFocused(_) => "uniform",
+            Self::StableCascades(_) => "cascades",
+            Self::TightCascades(_) => "tight_cascades",
+            Self::Lispsm(_) => "lispsm",
+            Self::Xpsm(_) => "xpsm",
+            Self::Tsm(_) => "tsm",
+            Self::WarpedCascades { .. } => "warped_cascades",
+            Self::Auto(_) => "auto",
+            Self::Rtw(_) => "rtw",
+            Self::RtwOracle(_) => "rtw_oracle",
+            Self::SpotFit { .. } => "spot",
+            Self::Dpsm(_) => "dpsm",
+            Self::Ipsm(o) => match o.fit {
+                ConeFit::Paper => "ipsm_paper",
+                ConeFit::Exact => "ipsm_exact",
+            },
+        }
+    }
+
+    /// The kind of light the technique is for.
+    #[must_use]
+    pub const fn light_kind(&self) -> LightKind {
+        match self {
+            Self::SpotFit { .. } => LightKind::Spot,
+            Self::Dpsm(_) | Self::Ipsm(_) => LightKind::Point,
+            _ => LightKind::Directional,
+        }
+    }
+
+    /// Whether the technique is meant for this light.
+    #[must_use]
+    pub const fn applies_to(&self, light: &Light) -> bool {
+        matches!(
+            (self.light_kind(), LightKind::of(light)),
+            (LightKind::Directional, LightKind::Directional)
+                | (LightKind::Spot, LightKind::Spot)
+                | (LightKind::Point, LightKind::Point)
+        )
+    }
+}

@@ -1,0 +1,409 @@
+//! Every technique through the one `fit`: over the shared generators, every visible
+//! receiver point lands inside the fitted map (uv in `[0, 1]²`, depth in `[0, 1]`, a
+//! layer the shadow has), up to `f32` rounding; missing inputs are typed errors.
+
+use glam::{DVec3, Vec3};
+use proptest::prelude::*;
+use shadowmap::frustum::{
+    Aabb, Camera, ConvexBody, Light, Projection, SceneBounds, ShadowMapping, ShadowTransform,
+    TechniqueSelector,
+};
+use shadowmap::rtw::EyeSample;
+use shadowmap::{
+    FitError, FitInput, Fitted, LightKind, Shadow, Technique, depth_bounds_of, fit,
+    fit_with_selector,
+};
+use shadowmap_testgen::arbitrary::Unstructured;
+use shadowmap_testgen::paraboloid::plan_input;
+use shadowmap_testgen::warp::{WarpCase, receiver_samples, warp_case};
+use shadowmap_testgen::{proptest_config, strategy};
+
+const BUDGET: u64 = 512 * 512;
+
+/// `f32` rounding of a matrix map at `p`, in uv / depth units (forward error bound of
+/// the homogeneous product and the division by `w`).
+fn rounding(t: &ShadowTransform, p: DVec3) -> f64 {
+    let m = t.uv_from_world.as_dmat4();
+    let h = p.extend(1.0);
+    let abs_row = |r: usize| {
+        (m.x_axis[r] * h.x).abs()
+            + (m.y_axis[r] * h.y).abs()
+            + (m.z_axis[r] * h.z).abs()
+            + m.w_axis[r].abs()
+    };
+    let hw = m * h;
+    let eps = 64.0 * f64::from(f32::EPSILON);
+    let w_err = eps * abs_row(3) / hw.w.abs();
+    let mut worst = 0.0f64;
+    for r in 0..3 {
+        let v = (hw[r] / hw.w).abs();
+        worst = worst.max(eps * abs_row(r) / hw.w.abs() + v * w_err);
+    }
+    1e-6 + worst
+}
+
+/// The matrix that maps `layer` of a matrix-based shadow (RTW: its base, whose warp
+/// keeps `[0, 1]` and clamps to the edge outside).
+fn layer_transform(shadow: &Shadow, layer: u32) -> Option<ShadowTransform> {
+    if let Some(t) = shadow.transform() {
+        return Some(*t);
+    }
+    if let Some(r) = shadow.rtw() {
+        return Some(r.base);
+    }
+    match shadow.fitted() {
+        Fitted::Cascades(set) => set.cascades.get(layer as usize).map(|c| c.transform),
+        Fitted::WarpedCascades { cascades, .. } => cascades
+            .cascades
+            .get(layer as usize)
+            .and_then(|c| c.shadow)
+            .map(|s| s.transform),
+        _ => None,
+    }
+}
+
+/// The view-depth range a cascaded shadow covers (`None`: not cascaded).
+fn cascaded_range(shadow: &Shadow) -> Option<(f32, f32)> {
+    match shadow.fitted() {
+        Fitted::Cascades(set) => Some((
+            set.splits.cascade_range(0)?.0,
+            set.splits.cascade_range(set.splits.count() - 1)?.1,
+        )),
+        Fitted::WarpedCascades { cascades, .. } => Some((
+            cascades.cascades.first()?.near,
+            cascades.cascades.last()?.far,
+        )),
+        _ => None,
+    }
+}
+
+/// Checks that every point maps inside the shadow, with tolerance `tol(layer, p)`.
+fn assert_inside(
+    shadow: &Shadow,
+    points: &[Vec3],
+    camera: &Camera,
+    tol: impl Fn(u32, DVec3) -> f64,
+) -> Result<(), TestCaseError> {
+    let name = shadow.technique().name();
+    for p in points {
+        let world = p.as_dvec3();
+        let Some(s) = shadow.map_point(world) else {
+            // Cascades select by view depth: a point at the first cascade's near or
+            // the last one's far depth may round out of them.
+            let d = camera.view_depth(*p);
+            let at_end = cascaded_range(shadow).is_some_and(|(near, far)| {
+                let edge = 1e-4 * far.abs().max(near.abs());
+                (d - near).abs() < edge || (d - far).abs() < edge
+            });
+            prop_assert!(at_end, "{name}: receiver {p} at depth {d} not mapped");
+            continue;
+        };
+        prop_assert!(s.layer < shadow.layers(), "{name}: layer {}", s.layer);
+        let tol = tol(s.layer, world);
+        let inside = |x: f64| (-tol..=1.0 + tol).contains(&x);
+        prop_assert!(
+            inside(s.uv.x) && inside(s.uv.y) && inside(s.depth),
+            "{name}: receiver {p} at uv {:?} depth {} (tol {tol})",
+            s.uv,
+            s.depth
+        );
+    }
+    Ok(())
+}
+
+fn eye_samples(camera: &Camera, points: &[Vec3]) -> Vec<EyeSample> {
+    points
+        .iter()
+        .map(|p| EyeSample {
+            position: *p,
+            normal: Vec3::ZERO,
+            eye_distance: p.distance(camera.eye()),
+        })
+        .collect()
+}
+
+fn of_kind(kind: LightKind) -> impl Iterator<Item = Technique> {
+    Technique::all_default()
+        .into_iter()
+        .filter(move |t| t.light_kind() == kind)
+}
+
+/// Fits every directional technique to a case and checks coverage of the visible
+/// receivers. Returns how many fits were checked.
+fn check_directional(case: &WarpCase, points: &[Vec3]) -> Result<usize, TestCaseError> {
+    let light = Light::Directional {
+        direction: case.light,
+    };
+    let samples = eye_samples(&case.camera, points);
+    let input = FitInput::new(&case.camera, &light, case.scene, BUDGET)
+        .with_eye_samples(&samples)
+        .with_pixels_per_radian(500.0);
+    let (r, c) = (case.scene.receivers, case.scene.casters);
+    let casters_hold_receivers = c.min.cmple(r.min).all() && r.max.cmple(c.max).all();
+    let mut checked = 0;
+    for technique in of_kind(LightKind::Directional) {
+        let result = fit(&technique, &input);
+        let shadow = match result {
+            Ok(s) => s,
+            // The plain matrix fits always succeed on visible receivers.
+            Err(e) => {
+                prop_assert!(
+                    !matches!(
+                        technique,
+                        Technique::UniformFocused(_) | Technique::Lispsm(_) | Technique::Tsm(_)
+                    ),
+                    "{}: {e}",
+                    technique.name()
+                );
+                continue;
+            }
+        };
+        // XPSM covers the receivers inside the casters' footprint only (documented).
+        let fitted_xpsm = matches!(shadow.fitted(), Fitted::Xpsm(_));
+        if fitted_xpsm && !casters_hold_receivers {
+            continue;
+        }
+        let tol = |layer, p| layer_transform(&shadow, layer).map_or(1e-4, |t| rounding(&t, p));
+        assert_inside(&shadow, points, &case.camera, tol)?;
+        checked += 1;
+    }
+    Ok(checked)
+}
+
+proptest! {
+    #![proptest_config(proptest_config())]
+
+    #[test]
+    fn directional_techniques_cover_visible_receivers(
+        case in strategy(warp_case),
+        bytes in proptest::collection::vec(any::<u8>(), 0..256),
+    ) {
+        let Some(points) = receiver_samples(&case, &mut Unstructured::new(&bytes)) else {
+            return Ok(());
+        };
+        // Visible: within the camera's depth range too (the body's clipping rounds).
+        let (near, far) = case.camera.depth_range().unwrap();
+        let points: Vec<Vec3> = points
+            .into_iter()
+            .filter(|p| (near..=far).contains(&case.camera.view_depth(*p)))
+            .collect();
+        check_directional(&case, &points)?;
+    }
+
+    #[test]
+    fn point_techniques_cover_the_truncated_frustum(input in strategy(plan_input)) {
+        let (position, range) = match input.light {
+            Light::Point { position, range } | Light::Spot { position, range, .. } => {
+                (position, range)
+            }
+            Light::Directional { .. } => return Ok(()),
+        };
+        let light = Light::Point { position, range };
+        let camera = &input.camera;
+        let scene = SceneBounds::whole(Aabb::new(Vec3::splat(-1.0), Vec3::ONE));
+        let fit_input = FitInput::new(camera, &light, scene, BUDGET).with_depth_bounds(input.bounds);
+        let Ok((near, far)) = input.bounds.map_or(camera.depth_range(), |b| b.clamped_to(camera))
+        else {
+            return Ok(());
+        };
+        let Ok(slice) = camera.slice(near, far) else { return Ok(()) };
+        for technique in of_kind(LightKind::Point) {
+            let Ok(shadow) = fit(&technique, &fit_input) else { continue };
+            let map = shadow.paraboloid().unwrap();
+            // The truncated frustum's corners and centre, where the light reaches them.
+            let centre = slice.corners.iter().copied().sum::<Vec3>() / 8.0;
+            let lit: Vec<Vec3> = slice
+                .corners
+                .iter()
+                .copied()
+                .chain([centre])
+                .filter(|p| {
+                    let d = p.distance(position);
+                    d > 1.01 * map.near && d < 0.99 * range
+                })
+                .collect();
+            assert_inside(&shadow, &lit, camera, |_, _| 1e-3)?;
+        }
+    }
+}
+
+/// A street-level camera over open ground.
+fn street() -> (Camera, SceneBounds) {
+    let camera = Camera::look_to(
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::new(0.0, -0.2, -1.0),
+        Vec3::Y,
+        Projection::perspective(1.0, 16.0 / 9.0, 0.5, 300.0),
+    )
+    .unwrap();
+    let ground = Aabb::new(Vec3::new(-150.0, 0.0, -320.0), Vec3::new(150.0, 1.0, 20.0));
+    let scene = SceneBounds::new(ground, Aabb::new(ground.min, ground.max + 30.0 * Vec3::Y));
+    (camera, scene)
+}
+
+/// The visible ground: vertices of frustum ∩ receivers and points between them.
+fn visible_ground(camera: &Camera, scene: &SceneBounds) -> Vec<Vec3> {
+    let body = ConvexBody::from_frustum_aabb(&camera.frustum().unwrap(), &scene.receivers).unwrap();
+    let v = body.vertices();
+    let mut points = v.to_vec();
+    for (i, a) in v.iter().enumerate() {
+        for b in &v[i + 1..] {
+            points.push(a.lerp(*b, 0.5));
+        }
+    }
+    points
+}
+
+#[test]
+fn every_directional_technique_fits_a_street_view() {
+    let (camera, scene) = street();
+    let points = visible_ground(&camera, &scene);
+    let case = WarpCase {
+        camera,
+        light: Vec3::new(0.4, -1.0, 0.3),
+        scene,
+        eta: 0.0,
+        reversed_z: false,
+    };
+    let checked = check_directional(&case, &points).unwrap();
+    assert_eq!(checked, of_kind(LightKind::Directional).count());
+}
+
+#[test]
+fn depth_bounds_shrink_the_cascades_to_the_samples() {
+    let (camera, scene) = street();
+    let light = Light::Directional {
+        direction: Vec3::new(0.4, -1.0, 0.3),
+    };
+    let points = visible_ground(&camera, &scene);
+    let near: Vec<Vec3> = points
+        .into_iter()
+        .filter(|p| camera.view_depth(*p) < 40.0)
+        .collect();
+    let samples = eye_samples(&camera, &near);
+    let bounds = depth_bounds_of(&camera, &samples).unwrap();
+    assert!(bounds.max < 40.0 && bounds.min < bounds.max);
+    let input = FitInput::new(&camera, &light, scene, BUDGET)
+        .with_eye_samples(&samples)
+        .with_depth_bounds(Some(bounds));
+    for technique in [
+        Technique::StableCascades(Default::default()),
+        Technique::TightCascades(Default::default()),
+        Technique::WarpedCascades {
+            plan: Default::default(),
+            lispsm: Default::default(),
+        },
+    ] {
+        let shadow = fit(&technique, &input).unwrap();
+        let tol = |layer, p| layer_transform(&shadow, layer).map_or(1e-4, |t| rounding(&t, p));
+        assert_inside(&shadow, &near, &camera, tol).unwrap();
+        // Nothing beyond the bounds is mapped: the cascades end there.
+        let far = camera.eye() + camera.forward() * (bounds.max * 1.5);
+        assert!(shadow.map_point(far.as_dvec3()).is_none());
+    }
+}
+
+#[test]
+fn spot_fit_covers_the_lit_view() {
+    let (camera, scene) = street();
+    let light = Light::Spot {
+        position: Vec3::new(0.0, 40.0, -30.0),
+        direction: Vec3::NEG_Y,
+        half_angle: 1.2,
+        range: 200.0,
+    };
+    let shadow = fit(
+        &Technique::SpotFit { reversed_z: false },
+        &FitInput::new(&camera, &light, scene, BUDGET),
+    )
+    .unwrap();
+    assert_eq!((shadow.layers(), shadow.layer_side()), (1, 512));
+    // Visible ground inside the cone and range.
+    let lit: Vec<Vec3> = visible_ground(&camera, &scene)
+        .into_iter()
+        .filter(|p| {
+            let d = *p - Vec3::new(0.0, 40.0, -30.0);
+            d.length() < 199.0 && d.normalize().dot(Vec3::NEG_Y) > 1.19f32.cos()
+        })
+        .collect();
+    assert!(lit.len() > 3);
+    let t = *shadow.transform().unwrap();
+    assert_inside(&shadow, &lit, &camera, |_, p| rounding(&t, p)).unwrap();
+}
+
+#[test]
+fn missing_inputs_and_wrong_lights_are_typed_errors() {
+    let (camera, scene) = street();
+    let sun = Light::Directional {
+        direction: Vec3::new(0.4, -1.0, 0.3),
+    };
+    let input = FitInput::new(&camera, &sun, scene, BUDGET);
+    assert_eq!(
+        fit(&Technique::Rtw(Default::default()), &input).unwrap_err(),
+        FitError::MissingInput {
+            technique: "rtw",
+            input: "eye_samples"
+        }
+    );
+    let samples = eye_samples(&camera, &visible_ground(&camera, &scene));
+    let with_samples = input.with_eye_samples(&samples);
+    assert!(fit(&Technique::Rtw(Default::default()), &with_samples).is_ok());
+    assert_eq!(
+        fit(&Technique::RtwOracle(Default::default()), &with_samples).unwrap_err(),
+        FitError::MissingInput {
+            technique: "rtw_oracle",
+            input: "pixels_per_radian"
+        }
+    );
+    for technique in Technique::all_default() {
+        let wrong = !technique.applies_to(&sun);
+        let r = fit(&technique, &with_samples.with_pixels_per_radian(400.0));
+        assert_eq!(wrong, r.is_err(), "{}", technique.name());
+        if wrong {
+            assert_eq!(
+                r.unwrap_err(),
+                FitError::WrongLight {
+                    technique: technique.name()
+                }
+            );
+        }
+    }
+    let none = FitInput::new(&camera, &sun, scene, 0);
+    assert_eq!(
+        fit(&Technique::Lispsm(Default::default()), &none).unwrap_err(),
+        FitError::InvalidBudget
+    );
+    // The math crate's own error, wrapped.
+    let nan = Light::Directional {
+        direction: Vec3::NAN,
+    };
+    let r = fit(
+        &Technique::Xpsm(Default::default()),
+        &FitInput::new(&camera, &nan, scene, BUDGET),
+    );
+    assert!(matches!(r, Err(FitError::Warp(_))), "{r:?}");
+}
+
+#[test]
+fn auto_reports_its_choice_and_keeps_it_with_a_selector() {
+    let (camera, scene) = street();
+    let sun = Light::Directional {
+        direction: Vec3::new(0.4, -1.0, 0.3),
+    };
+    let input = FitInput::new(&camera, &sun, scene, BUDGET);
+    let auto = Technique::Auto(Default::default());
+    let chosen = fit(&auto, &input).unwrap();
+    assert_eq!(chosen.requested(), &auto);
+    assert_ne!(chosen.technique(), &auto);
+    // A perspective view over open ground: a warp or cascades beat the uniform fit.
+    assert!(!matches!(chosen.technique(), Technique::UniformFocused(_)));
+    let same = fit(chosen.technique(), &input).unwrap();
+    let p = DVec3::new(1.0, 0.0, -20.0);
+    assert_eq!(chosen.map_point(p), same.map_point(p));
+    // A selector that holds the uniform fit with a wide margin keeps it.
+    let mut selector = TechniqueSelector::new().with_switch_margin(0.999);
+    selector.current = Some(0);
+    let kept = fit_with_selector(&auto, &input, &mut selector).unwrap();
+    assert!(matches!(kept.technique(), Technique::UniformFocused(_)));
+    assert_eq!(selector.current, Some(0));
+}

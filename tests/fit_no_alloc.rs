@@ -1,0 +1,74 @@
+//! `fit` allocates nothing per frame for every technique but RTW (its importance map
+//! and tables), `auto` included, under a counting global allocator (one test in this
+//! binary, so nothing else allocates meanwhile).
+
+use std::alloc::System;
+
+use glam::Vec3;
+use shadowmap::frustum::{Aabb, Camera, Light, Projection, SceneBounds, TechniqueSelector};
+use shadowmap::{FitInput, Technique, fit_with_selector};
+use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
+
+#[global_allocator]
+static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
+
+#[test]
+fn fit_does_not_allocate() {
+    let camera = Camera::look_to(
+        Vec3::new(3.0, 2.0, 1.0),
+        Vec3::new(0.2, -0.1, -1.0),
+        Vec3::Y,
+        Projection::perspective(1.0, 1.6, 0.1, 300.0),
+    )
+    .unwrap();
+    let ground = Aabb::new(Vec3::new(-200.0, -1.0, -300.0), Vec3::new(200.0, 0.0, 10.0));
+    let scene = SceneBounds::new(
+        ground,
+        ground.union(&Aabb::new(Vec3::ZERO, Vec3::splat(40.0))),
+    );
+    let sun = Light::Directional {
+        direction: Vec3::new(-0.3, -1.0, -0.4),
+    };
+    let lamp = Light::Point {
+        position: Vec3::new(2.0, 3.0, -8.0),
+        range: 60.0,
+    };
+    let spot = Light::Spot {
+        position: Vec3::new(0.0, 30.0, -20.0),
+        direction: Vec3::NEG_Y,
+        half_angle: 1.0,
+        range: 100.0,
+    };
+    let techniques: Vec<Technique> = Technique::all_default()
+        .into_iter()
+        .filter(|t| !matches!(t, Technique::Rtw(_) | Technique::RtwOracle(_)))
+        .collect();
+    assert_eq!(techniques.len(), 12);
+    let mut selector = TechniqueSelector::new();
+
+    let region = Region::new(GLOBAL);
+    let mut fitted = 0;
+    for frame in 0..5 {
+        let camera = Camera {
+            world_from_view: glam::Mat4::from_translation(Vec3::new(frame as f32 * 0.37, 0.0, 0.0))
+                * camera.world_from_view,
+            ..camera
+        };
+        for technique in &techniques {
+            let light = [&sun, &lamp, &spot]
+                .into_iter()
+                .find(|l| technique.applies_to(l))
+                .unwrap();
+            let input = FitInput::new(&camera, light, scene, 2048 * 2048);
+            let shadow = fit_with_selector(technique, &input, &mut selector).unwrap();
+            fitted += shadow.layers();
+        }
+    }
+    let stats = region.change();
+    assert!(fitted >= 5 * 12);
+    assert_eq!(
+        (stats.allocations, stats.reallocations),
+        (0, 0),
+        "{stats:?}"
+    );
+}
