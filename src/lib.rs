@@ -127,3 +127,8 @@ pub use fit::{FitError, FitInput, depth_bounds_of, fit, fit_with_selector, layer
 pub use shadow::{Fitted, Shadow};
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 pub use technique::{CascadePlan, DpsmOptions, LightKind, RtwPlan, Technique};
+
+/// The README's examples, compiled and run as doctests so they cannot rot.
+#[cfg(all(doctest, feature = "warp", feature = "paraboloid", feature = "rtw"))]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -9,6 +9,7 @@ use shadowmap_warp::{LispsmShadow, TsmShadow, WarpedCascades, WarpedCascadesView
 use crate::Technique;
 
 /// The result of one fit, as the math crate that built it returns it.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 // Cascade sets and warped cascades keep their fixed-capacity arrays inline, so a fit
@@ -59,6 +60,8 @@ pub enum Fitted {
 ///
 /// It is a [`ShadowMapping`]: world point to `(uv, depth, layer)`, the same lookup a
 /// shader does.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(try_from = "ShadowData"))]
 #[derive(Clone, Debug, PartialEq)]
 pub struct Shadow {
     pub(crate) requested: Technique,
@@ -150,6 +153,59 @@ impl Shadow {
             } => Some(cascades.view(*eye, *forward)),
             _ => None,
         }
+    }
+}
+
+impl Fitted {
+    /// Layers of this result: cascades, paraboloid sides, 1 for a single map.
+    #[must_use]
+    pub fn layer_count(&self) -> u32 {
+        let count = match self {
+            Self::Cascades(set) => set.cascades.len(),
+            Self::WarpedCascades { cascades, .. } => cascades.cascades.len(),
+            Self::Dpsm(map) => map.layers() as usize,
+            Self::Ipsm(plan) => plan.map.layers() as usize,
+            _ => 1,
+        };
+        u32::try_from(count).unwrap_or(u32::MAX)
+    }
+}
+
+/// A [`Shadow`] as read from a serialized payload, checked before it becomes one.
+#[cfg(feature = "serde")]
+#[derive(serde::Deserialize)]
+struct ShadowData {
+    requested: Technique,
+    technique: Technique,
+    fitted: Fitted,
+    layers: u32,
+    layer_side: u32,
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<ShadowData> for Shadow {
+    type Error = &'static str;
+
+    /// The layer count must be the result's, the side a map side `fit` can make
+    /// (`4..=65536`), and the fitted technique the requested one unless `auto` chose.
+    fn try_from(data: ShadowData) -> Result<Self, Self::Error> {
+        if data.layers != data.fitted.layer_count() {
+            return Err("layers do not match the fitted result");
+        }
+        if !(4..=shadowmap_frustum::MAX_RESOLUTION).contains(&data.layer_side) {
+            return Err("layer side out of range");
+        }
+        let auto = matches!(data.requested, Technique::Auto(_));
+        if !auto && data.requested != data.technique {
+            return Err("fitted technique differs from the requested one");
+        }
+        Ok(Self {
+            requested: data.requested,
+            technique: data.technique,
+            fitted: data.fitted,
+            layers: data.layers,
+            layer_side: data.layer_side,
+        })
     }
 }
 

@@ -9,6 +9,7 @@ use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 /// A shadow technique with its options, chosen by value and fitted by
 /// [`fit`](crate::fit). Which light each one is for, and which optional
 /// [`FitInput`](crate::FitInput) fields it reads, is in the crate docs' table.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum Technique {
@@ -63,6 +64,8 @@ pub enum Technique {
 
 /// Splits of the cascaded techniques: practical splits (Zhang et al.) of the eye's
 /// depth bounds, the count chosen from their ratio (see the crate docs).
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct CascadePlan {
@@ -97,6 +100,8 @@ impl CascadePlan {
 }
 
 /// Knobs of RTW and the RTW oracle.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct RtwPlan {
@@ -140,6 +145,8 @@ impl RtwPlan {
 }
 
 /// Knobs of the dual paraboloid map.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct DpsmOptions {

@@ -15,6 +15,7 @@
 //! | [`uniforms`] | `#[repr(C)]` blocks built by [`uniforms::ToRaw`] |
 //! | [`depth`] | [`depth::ShadowDepthPass`]: matrix / paraboloid / RTW depth passes, caster subdivision for RTW |
 //! | [`render`] | [`render::HeadlessRenderer`]: scene pass with a lookup and a filter composed in, PNGs, shadow masks |
+//! | [`shadow`] | [`render::HeadlessRenderer::render_shadow`]: a fitted `shadowmap::Shadow` to the renderer, the one match from fitted result to lookup and depth pass |
 //! | [`profile`] | [`profile::GpuProfiler`]: GPU time per pass from timestamp queries |
 //! | [`reduce`] | depth min/max reduction (SDSM, IPSM depth bounds) |
 //! | [`rtw`] | [`rtw::GpuRtw`]: importance, blur, warp tables on the GPU |
