@@ -6,14 +6,13 @@
 //! profiled render draws the same frame and times its passes.
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
+use shadowmap::frustum::{Aabb, Camera, Light, Projection, ShadowMapping};
+use shadowmap::warp::{LispsmOptions, SceneBounds, WarpedCascades};
+use shadowmap::{CascadePlan, FitInput, Fitted, Technique};
 use shadowmap_eval::bvh::Bvh;
 use shadowmap_eval::mask::shadow_mask;
 use shadowmap_eval::raster::{DepthMap, MatrixProjector, RasterOptions, rasterize_depth};
 use shadowmap_eval::scene::Mesh;
-use shadowmap_frustum::{
-    Aabb, Camera, CascadeSplits, Projection, ShadowMapping, ShadowSample, SplitScheme,
-};
-use shadowmap_warp::{LispsmOptions, SceneBounds, WarpedCascades, warped_cascades};
 use shadowmap_wgpu::depth::DepthBias;
 use shadowmap_wgpu::profile::GpuProfiler;
 use shadowmap_wgpu::render::{
@@ -70,41 +69,25 @@ fn camera() -> Camera {
     .unwrap()
 }
 
+/// Warped cascades (up to 3, split weight 0.8) fitted through the one `fit`.
 fn fit(reversed_z: bool) -> WarpedCascades {
-    let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.8 }, 3, 0.5, 150.0)
-        .unwrap()
-        .with_overlap(0.1)
-        .unwrap();
-    warped_cascades(
-        &camera(),
-        LIGHT,
-        &SceneBounds::whole(bounds()),
-        &splits,
-        &[0.0; 3],
-        &LispsmOptions::default().with_reversed_z(reversed_z),
-    )
-    .unwrap()
-}
-
-/// The CPU mapping: the first cascade whose `[near, far]` holds the view depth,
-/// through its LiSPSM matrices; not covered where that cascade has no fit.
-struct Reference<'a> {
-    camera: Camera,
-    set: &'a WarpedCascades,
-}
-
-impl ShadowMapping for Reference<'_> {
-    fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
-        let depth = f64::from(self.camera.view_depth(world.as_vec3()));
-        let (i, c) = self
-            .set
-            .cascades
-            .iter()
-            .enumerate()
-            .find(|(_, c)| depth >= f64::from(c.near) && depth <= f64::from(c.far))?;
-        let mut s = c.shadow.as_ref()?.transform.map_point(world)?;
-        s.layer = u32::try_from(i).ok()?;
-        Some(s)
+    let technique = Technique::WarpedCascades {
+        plan: CascadePlan::default()
+            .with_max_cascades(3)
+            .with_split_lambda(0.8),
+        lispsm: LispsmOptions::default().with_reversed_z(reversed_z),
+    };
+    let light = Light::Directional { direction: LIGHT };
+    let camera = camera();
+    let input = FitInput::new(
+        &camera,
+        &light,
+        SceneBounds::whole(bounds()),
+        3 * u64::from(RES * RES),
+    );
+    match shadowmap::fit(&technique, &input).unwrap().fitted() {
+        Fitted::WarpedCascades { cascades, .. } => cascades.clone(),
+        other => panic!("warped cascades expected, got {other:?}"),
     }
 }
 
@@ -175,13 +158,11 @@ fn check_against_cpu(ctx: &GpuContext, renderer: &mut HeadlessRenderer, reversed
         )
         .expect("render")
         .mask;
-    let reference = Reference {
-        camera: camera(),
-        set: &set,
-    };
+    let camera = camera();
+    let reference = set.view_from(&camera);
     let bvh = Bvh::build(&mesh()).unwrap();
     let depth = cpu_depth(&set, reversed_z);
-    let cpu = shadow_mask(&bvh, &camera(), W, H, &reference, &depth, BIAS).unwrap();
+    let cpu = shadow_mask(&bvh, &camera, W, H, &reference, &depth, BIAS).unwrap();
     let name = if reversed_z { "reversed-Z" } else { "standard" };
     let differing = gpu
         .values
@@ -200,7 +181,7 @@ fn check_against_cpu(ctx: &GpuContext, renderer: &mut HeadlessRenderer, reversed
     );
     // Every cascade is the one selected somewhere in the image.
     let mut used = vec![0usize; set.cascades.len()];
-    let gbuffer = shadowmap_eval::mask::GBuffer::trace(&bvh, &camera(), W, H).unwrap();
+    let gbuffer = shadowmap_eval::mask::GBuffer::trace(&bvh, &camera, W, H).unwrap();
     for y in 0..H {
         for x in 0..W {
             if let Some(s) = gbuffer
@@ -253,13 +234,14 @@ fn cascade_sets_without_a_fitted_cascade_are_typed_errors() {
             "{result:?}"
         );
     }
-    let mut cascades = shadowmap_frustum::CascadeSet::fit(
-        &camera(),
-        LIGHT,
-        &CascadeSplits::new(&SplitScheme::Logarithmic, 2, 0.5, 150.0).unwrap(),
-        &shadowmap_frustum::CascadeOptions::default(),
-    )
-    .unwrap();
+    let light = Light::Directional { direction: LIGHT };
+    let camera = camera();
+    let input = FitInput::new(&camera, &light, SceneBounds::whole(bounds()), 1 << 20);
+    let tight = Technique::TightCascades(CascadePlan::default());
+    let Fitted::Cascades(mut cascades) = shadowmap::fit(&tight, &input).unwrap().fitted().clone()
+    else {
+        panic!("cascades expected");
+    };
     cascades.cascades.clear();
     for t in [
         ShadowTechnique::Cascades(&cascades),
