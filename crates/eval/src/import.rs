@@ -77,7 +77,8 @@ pub fn obj_from_bytes(bytes: &[u8], path: &Path) -> Result<Mesh, EvalError> {
         ignore_points: true,
         ignore_lines: true,
     };
-    let mut reader = std::io::BufReader::new(bytes);
+    let statements = positions_and_faces(std::str::from_utf8(bytes).unwrap_or_default());
+    let mut reader = std::io::BufReader::new(statements.as_bytes());
     let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
@@ -98,6 +99,31 @@ pub fn obj_from_bytes(bytes: &[u8], path: &Path) -> Result<Mesh, EvalError> {
         mesh.append(&Mesh { positions, indices });
     }
     finish(path, mesh)
+}
+
+/// The statements of an OBJ text that a shadow caster needs: vertex positions (`v`)
+/// and faces (`f`) with their position indices only; texture coordinates, normals,
+/// lines, points, groups and materials are dropped. `tobj` checks position indices
+/// but not texture-coordinate or normal indices (a huge one overflows inside it), so
+/// it is never given any. Statements are split on whitespace as `tobj` splits them.
+fn positions_and_faces(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        let mut tokens = line.split_whitespace();
+        match tokens.next() {
+            Some("v") => out.push_str(line),
+            Some("f") => {
+                out.push('f');
+                for token in tokens {
+                    out.push(' ');
+                    out.push_str(token.split('/').next().unwrap_or_default());
+                }
+            }
+            _ => continue,
+        }
+        out.push('\n');
+    }
+    out
 }
 
 /// Loads all meshes of a glTF file's default scene (the first scene if none is

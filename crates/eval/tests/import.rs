@@ -194,3 +194,31 @@ fn in_memory_gltf_with_an_external_buffer_needs_a_directory() {
     let e = gltf_from_bytes(json.as_bytes(), Path::new("m.gltf"), None).unwrap_err();
     assert!(e.to_string().contains("tri.bin"), "{e}");
 }
+
+#[test]
+fn obj_with_a_huge_texture_coordinate_index_is_read_without_panicking() {
+    // Found by the `import_obj` fuzz target: a line element whose texture-coordinate
+    // index overflows inside the OBJ parser. Only positions and faces reach it now.
+    let result = load_obj(data("huge_texcoord_index.obj"));
+    assert!(
+        matches!(
+            result,
+            Err(EvalError::Malformed { .. } | EvalError::NoTriangles { .. })
+        ),
+        "{result:?}"
+    );
+}
+
+#[test]
+fn obj_texture_coordinates_and_normals_do_not_change_the_mesh() {
+    let plain = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 4\n";
+    let full = "vt 0 0\nvn 0 0 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+                f 1/1/1 2/1/1 3//1 4/1\nl 1/99999999999999999999 2\n";
+    let a = shadowmap_eval::import::obj_from_bytes(plain.as_bytes(), Path::new("a.obj")).unwrap();
+    let b = shadowmap_eval::import::obj_from_bytes(full.as_bytes(), Path::new("b.obj")).unwrap();
+    assert_eq!(a.triangle_count(), 2);
+    assert_eq!(
+        (a.positions.clone(), a.indices.clone()),
+        (b.positions.clone(), b.indices.clone())
+    );
+}

@@ -1,3 +1,8 @@
+//! An engine's frame loop in small: the eye's G-buffer gives the visible samples, every
+//! technique is chosen by value (`shadowmap::Technique`) and fitted by the one
+//! `shadowmap::fit`, and the fitted `Shadow` goes to the backend
+//! (`HeadlessRenderer::render_shadow`) with no per-technique code.
+//!
 //! Renders the city block with every technique and writes one PNG per technique to
 //! `rendered/` of the report directory (`--out`, default `target/shadowmap-report`
 //! relative to the working directory, as for `compare`). The `index.html` that
@@ -10,19 +15,22 @@
 
 use std::path::PathBuf;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
+use shadowmap::frustum::{Camera, Light, Projection};
+use shadowmap::{FitInput, LightKind, Technique, fit};
+use shadowmap_eval::bvh::Bvh;
+use shadowmap_eval::mask::GBuffer;
 use shadowmap_eval::scene::Scene;
-use shadowmap_frustum::{
-    Camera, CascadeOptions, CascadeSet, CascadeSplits, Projection, SplitScheme,
-};
-use shadowmap_paraboloid::{MapOptions, ParaboloidMap};
-use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
-use shadowmap_warp::{
-    LispsmOptions, SceneBounds, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
-    uniform_focused, xpsm,
-};
+use shadowmap_eval::technique::eye_samples;
 use shadowmap_wgpu::GpuContext;
-use shadowmap_wgpu::render::{HeadlessRenderer, RenderOptions, ShadowFilter, ShadowTechnique};
+use shadowmap_wgpu::render::{HeadlessRenderer, RenderOptions, ShadowFilter};
+
+/// Image size, and the G-buffer's (a quarter in each direction: enough samples for
+/// RTW's importance and the cascades' depth bounds).
+const WIDTH: u32 = 960;
+const HEIGHT: u32 = 540;
+/// Texels per technique, all layers together.
+const BUDGET: u64 = 2048 * 2048;
 
 const USAGE: &str = "usage: render_scene [--out DIR]
 
@@ -68,83 +76,58 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .triangles()
         .map(|t| t.map(glam::DVec3::as_vec3))
         .collect();
-    let bounds = scene.bounds().ok_or("empty scene")?;
-    let focus = SceneBounds::whole(bounds);
+    let scene_bounds = scene.scene_bounds().ok_or("empty scene")?;
     let camera = Camera::look_at(
         Vec3::new(-20.0, 25.0, 110.0),
         Vec3::new(0.0, 0.0, 0.0),
         Vec3::Y,
         Projection::perspective(55f32.to_radians(), 16.0 / 9.0, 1.0, 400.0),
     )?;
-    let light = Vec3::new(0.5, -0.8, -0.4);
+    let gbuffer = GBuffer::trace(&Bvh::build(&scene.mesh)?, &camera, WIDTH / 4, HEIGHT / 4)?;
+    let samples = eye_samples(&gbuffer, &camera);
+    let sun = Light::Directional {
+        direction: Vec3::new(0.5, -0.8, -0.4),
+    };
+    let lamp = Light::Point {
+        position: Vec3::new(5.0, 40.0, 10.0),
+        range: 600.0,
+    };
     let options = RenderOptions::default()
-        .with_size(960, 540)
-        .with_shadow_resolution(2048)
+        .with_size(WIDTH, HEIGHT)
         .with_filter(ShadowFilter::Pcf {
             taps: 3,
             radius: 1.0,
         });
-
-    let uniform = uniform_focused(&camera, light, &focus, &UniformOptions::default())?;
-    let l = lispsm(&camera, light, &focus, &LispsmOptions::default())?;
-    let x = xpsm(&camera, light, &focus, &XpsmOptions::default())?;
-    let t = tsm(&camera, light, &focus, &TsmOptions::default())?;
-    let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.7 }, 4, 1.0, 400.0)?
-        .with_overlap(0.1)?;
-    let set = CascadeSet::fit(
-        &camera,
-        light,
-        &splits,
-        &CascadeOptions::default()
-            .with_resolution(2048)
-            .with_scene(scene.scene_bounds()),
-    )?;
-    let map = ParaboloidMap::dual(
-        Vec3::new(5.0, 40.0, 10.0),
-        Vec3::NEG_Y,
-        0.5,
-        600.0,
-        &MapOptions::default(),
-    )?;
-    // RTW importance: the ground near the camera matters most.
-    let mut importance = ImportanceMap::new(128, 128)?;
-    for k in 0..64 {
-        let z = -100.0 + 3.2 * k as f32;
-        for x in [-40.0f32, 0.0, 40.0] {
-            if let Some(s) = uniform.project(Vec3::new(x, 0.0, z)) {
-                let weight = 1.0 / (1.0 + (110.0 - z).max(1.0) / 20.0);
-                let _ = importance.splat(s.uv.as_vec2(), weight);
-            }
-        }
-    }
-    let _ = importance.splat(Vec2::splat(0.5), 0.1);
-    let mut warps = WarpMaps::new(128, 128)?;
-    warps.build(&importance, &WarpOptions::default().with_blur_radius(4))?;
-    let rtw = RtwShadow {
-        base: uniform,
-        warps: &warps,
-    };
+    let pixels_per_radian = HEIGHT as f32 / 2.0 / (55f32.to_radians() / 2.0).tan();
 
     let mut renderer = HeadlessRenderer::new();
-    let jobs: [(&str, ShadowTechnique<'_>, RenderOptions); 8] = [
-        ("uniform", ShadowTechnique::Matrix(&uniform), options),
-        ("cascades", ShadowTechnique::Cascades(&set), options),
-        ("lispsm", ShadowTechnique::Matrix(&l.transform), options),
-        ("xpsm", ShadowTechnique::Xpsm(&x), options),
-        ("tsm", ShadowTechnique::Matrix(&t.transform), options),
-        ("paraboloid", ShadowTechnique::Paraboloid(&map), options),
-        ("rtw", ShadowTechnique::Rtw(&rtw), options),
-        (
-            "cascades_vsm",
-            ShadowTechnique::Cascades(&set),
-            options.with_filter(ShadowFilter::Vsm { blur_radius: 3 }),
-        ),
-    ];
-    for (name, technique, opts) in jobs {
-        let frame = renderer.render(&ctx, &triangles, &camera, &technique, &opts)?;
-        let path = dir.join(format!("{name}.png"));
+    for technique in Technique::all_default() {
+        let light = match technique.light_kind() {
+            LightKind::Directional => &sun,
+            LightKind::Point => &lamp,
+            _ => continue,
+        };
+        let input = FitInput::new(&camera, light, scene_bounds, BUDGET)
+            .with_eye_samples(&samples)
+            .with_pixels_per_radian(pixels_per_radian);
+        let shadow = fit(&technique, &input)?;
+        let frame = renderer.render_shadow(&ctx, &triangles, &camera, &shadow, &options)?;
+        let path = dir.join(format!("{}.png", technique.name()));
         frame.image.save_png(&path)?;
-        eprintln!("wrote {}", path.display());
+        eprintln!(
+            "wrote {} ({} layer(s) of {}²)",
+            path.display(),
+            shadow.layers(),
+            shadow.layer_side()
+        );
     }
+    // The same stable cascades, filtered with variance shadow maps.
+    let input = FitInput::new(&camera, &sun, scene_bounds, BUDGET).with_eye_samples(&samples);
+    let cascades = fit(&Technique::StableCascades(Default::default()), &input)?;
+    let vsm = options.with_filter(ShadowFilter::Vsm { blur_radius: 3 });
+    let frame = renderer.render_shadow(&ctx, &triangles, &camera, &cascades, &vsm)?;
+    let path = dir.join("cascades_vsm.png");
+    frame.image.save_png(&path)?;
+    eprintln!("wrote {}", path.display());
     Ok(())
 }
