@@ -273,6 +273,7 @@ fn fit_cascades(
     let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
     let fit = CascadeOptions::default()
         .with_resolution(input.layer_side(layers))
+        .with_reversed_z(plan.reversed_z)
         .with_scene(Some(input.scene));
     let fit = if stable {
         fit.with_stable_size_step(Some(STABLE_SIZE_STEP))
@@ -335,7 +336,7 @@ fn cascade_splits(plan: &CascadePlan, input: &FitInput<'_>) -> Result<CascadeSpl
     let scheme = SplitScheme::Practical {
         lambda: plan.split_lambda,
     };
-    Ok(CascadeSplits::new(&scheme, count, near, far)?)
+    Ok(CascadeSplits::new(&scheme, count, near, far)?.with_overlap(plan.overlap)?)
 }
 
 fn fit_rtw(

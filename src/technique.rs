@@ -73,6 +73,12 @@ pub struct CascadePlan {
     pub max_cascades: usize,
     /// Practical split weight (0 uniform, 1 logarithmic). Default 0.5.
     pub split_lambda: f32,
+    /// Blend band: the last `overlap` fraction (in `[0, 1)`) of each cascade's range is
+    /// blended with the next cascade. Default 0 (no band).
+    pub overlap: f32,
+    /// Reversed-Z depth (1 at the light's near plane) of the stable and tight
+    /// cascades; warped cascades take it from their LiSPSM options. Default `false`.
+    pub reversed_z: bool,
 }
 
 impl Default for CascadePlan {
@@ -80,6 +86,8 @@ impl Default for CascadePlan {
         Self {
             max_cascades: 4,
             split_lambda: 0.5,
+            overlap: 0.0,
+            reversed_z: false,
         }
     }
 }
@@ -95,6 +103,18 @@ impl CascadePlan {
     #[must_use]
     pub const fn with_split_lambda(mut self, lambda: f32) -> Self {
         self.split_lambda = lambda;
+        self
+    }
+    /// With this blend band (see [`overlap`](Self::overlap)).
+    #[must_use]
+    pub const fn with_overlap(mut self, overlap: f32) -> Self {
+        self.overlap = overlap;
+        self
+    }
+    /// With reversed-Z depth (see [`reversed_z`](Self::reversed_z)).
+    #[must_use]
+    pub const fn with_reversed_z(mut self, reversed_z: bool) -> Self {
+        self.reversed_z = reversed_z;
         self
     }
 }

@@ -10,35 +10,35 @@
 //! cargo run --release -p shadowmap-wgpu --example gpu_frame [-- --json] [-- --frames N]
 //! ```
 //!
-//! Each technique renders `frames` times (default 5) after one warm-up frame and
-//! reports the median of each figure. The RTW row uses warp tables built on the CPU
-//! from a fixed importance (its G-buffer analysis passes are not part of this
-//! frame); the cascade budget is split into four 1024² layers, the dual paraboloid's
-//! into two 1448² sides (the same texel count, as near as a power of two allows
-//! for the cascades).
+//! Every technique is fitted by value through `shadowmap::fit` with the same inputs
+//! (`fit ms` includes, for RTW, its importance and tables built on the CPU from the
+//! eye samples of a G-buffer traced at an eighth of the image size; the GPU analysis
+//! passes are not part of this frame), and renders `frames` times (default 5) after
+//! one warm-up frame; the median of each figure is reported. Layers share the budget
+//! as `fit` splits it (cascades by the depth range, the dual paraboloid into two
+//! sides).
 
 use std::fmt::Write as _;
 use std::io::Write as _;
 use std::time::Instant;
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec3, Vec3};
+use shadowmap::frustum::{Camera, Light, Projection};
+use shadowmap::{FitInput, LightKind, Technique, fit};
+use shadowmap_eval::bvh::Bvh;
+use shadowmap_eval::mask::GBuffer;
 use shadowmap_eval::scene::Scene;
-use shadowmap_frustum::{
-    Camera, CascadeOptions, CascadeSet, CascadeSplits, Projection, ShadowTransform, SplitScheme,
-};
-use shadowmap_paraboloid::{MapOptions, ParaboloidMap};
-use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
-use shadowmap_warp::{
-    LispsmOptions, SceneBounds, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
-    uniform_focused, warped_cascades, xpsm,
-};
+use shadowmap_eval::technique::eye_samples;
 use shadowmap_wgpu::GpuContext;
 use shadowmap_wgpu::profile::{GpuProfiler, PassTime};
 use shadowmap_wgpu::render::{HeadlessRenderer, RenderOptions, ShadowFilter, ShadowTechnique};
+use shadowmap_wgpu::shadow::with_technique;
 
 const WIDTH: u32 = 1920;
 const HEIGHT: u32 = 1080;
 const BUDGET: u32 = 2048;
+/// Vertical field of view of the camera, radians.
+const FOV_Y: f32 = 60.0 * core::f32::consts::PI / 180.0;
 
 /// The measured figures of one technique.
 struct Row {
@@ -129,24 +129,6 @@ impl Frame<'_> {
     }
 }
 
-/// The RTW tables: importance falling off with distance from the camera, splatted
-/// along the streets in the base map.
-fn rtw_warps(base: &ShadowTransform) -> Result<WarpMaps, Box<dyn std::error::Error>> {
-    let mut importance = ImportanceMap::new(256, 256)?;
-    for k in 0..96 {
-        let z = -110.0 + 2.5 * k as f32;
-        for x in [-50.0f32, -25.0, 0.0, 25.0, 50.0] {
-            if let Some(s) = base.project(Vec3::new(x, 0.0, z)) {
-                let _ = importance.splat(s.uv.as_vec2(), 1.0 / (1.0 + (120.0 - z) / 25.0));
-            }
-        }
-    }
-    let _ = importance.splat(Vec2::splat(0.5), 0.05);
-    let mut warps = WarpMaps::new(256, 256)?;
-    warps.build(&importance, &WarpOptions::default().with_blur_radius(4))?;
-    Ok(warps)
-}
-
 fn table(adapter: &str, profiler: &GpuProfiler, rows: &[Row]) -> Result<String, std::fmt::Error> {
     let mut out = String::new();
     writeln!(out, "adapter: {adapter}")?;
@@ -210,99 +192,47 @@ fn json(adapter: &str, profiler: &GpuProfiler, rows: &[Row]) -> String {
     )
 }
 
-/// Fits and measures every technique, in the order of the table.
+/// Fits every technique by value through `shadowmap::fit`, as an engine would, and
+/// measures it: the eye's samples (a G-buffer traced at an eighth of the image size)
+/// feed RTW's importance and the cascades' depth bounds; the fitted `Shadow` goes to
+/// the backend through its one match (`with_technique`).
 fn measure_all(
     frame: &Frame<'_>,
     profiler: &mut GpuProfiler,
-    focus: &SceneBounds,
     scene: &Scene,
 ) -> Result<Vec<Row>, Box<dyn std::error::Error>> {
     let camera = frame.camera;
-    let light = Vec3::new(0.45, -0.8, -0.35);
+    let bounds = scene.scene_bounds().ok_or("empty scene")?;
+    let gbuffer = GBuffer::trace(&Bvh::build(&scene.mesh)?, camera, WIDTH / 8, HEIGHT / 8)?;
+    let samples = eye_samples(&gbuffer, camera);
+    let sun = Light::Directional {
+        direction: Vec3::new(0.45, -0.8, -0.35),
+    };
+    let lamp = Light::Point {
+        position: Vec3::new(5.0, 45.0, 10.0),
+        range: 600.0,
+    };
+    let pixels_per_radian = HEIGHT as f32 / 2.0 / (FOV_Y / 2.0).tan();
+    let budget = u64::from(BUDGET) * u64::from(BUDGET);
     let mut renderer = HeadlessRenderer::new();
     let mut rows = Vec::new();
-    let mut run = |name, resolution, fit: Instant, t: &ShadowTechnique<'_>| {
-        let fit_ms = ms_since(fit);
-        frame.measure(&mut renderer, profiler, (name, resolution, fit_ms), t)
-    };
-
-    let t = Instant::now();
-    let uniform = uniform_focused(camera, light, focus, &UniformOptions::default())?;
-    rows.push(run(
-        "uniform",
-        BUDGET,
-        t,
-        &ShadowTechnique::Matrix(&uniform),
-    )?);
-    let t = Instant::now();
-    let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.7 }, 4, 1.0, 500.0)?
-        .with_overlap(0.1)?;
-    let options = CascadeOptions::default()
-        .with_resolution(BUDGET / 2)
-        .with_scene(scene.scene_bounds());
-    let set = CascadeSet::fit(camera, light, &splits, &options)?;
-    rows.push(run(
-        "cascades_4",
-        BUDGET / 2,
-        t,
-        &ShadowTechnique::Cascades(&set),
-    )?);
-    let t = Instant::now();
-    let l = lispsm(camera, light, focus, &LispsmOptions::default())?;
-    rows.push(run(
-        "lispsm",
-        BUDGET,
-        t,
-        &ShadowTechnique::Matrix(&l.transform),
-    )?);
-    let t = Instant::now();
-    let x = xpsm(camera, light, focus, &XpsmOptions::default())?;
-    rows.push(run("xpsm", BUDGET, t, &ShadowTechnique::Xpsm(&x))?);
-    let t = Instant::now();
-    let tr = tsm(camera, light, focus, &TsmOptions::default())?;
-    rows.push(run(
-        "tsm",
-        BUDGET,
-        t,
-        &ShadowTechnique::Matrix(&tr.transform),
-    )?);
-    let t = Instant::now();
-    let w = warped_cascades(
-        camera,
-        light,
-        focus,
-        &splits,
-        &[0.0; 4],
-        &LispsmOptions::default(),
-    )?;
-    rows.push(run(
-        "warped_cascades_4",
-        BUDGET / 2,
-        t,
-        &ShadowTechnique::WarpedCascades(&w),
-    )?);
-    let t = Instant::now();
-    let warps = rtw_warps(&uniform)?;
-    let rtw = RtwShadow {
-        base: uniform,
-        warps: &warps,
-    };
-    rows.push(run(
-        "rtw_cpu_tables",
-        BUDGET,
-        t,
-        &ShadowTechnique::Rtw(&rtw),
-    )?);
-    let t = Instant::now();
-    let map = ParaboloidMap::dual(
-        Vec3::new(5.0, 45.0, 10.0),
-        Vec3::NEG_Y,
-        0.5,
-        600.0,
-        &MapOptions::default(),
-    )?;
-    rows.push(run("dpsm", 1448, t, &ShadowTechnique::Paraboloid(&map))?);
-
+    for technique in Technique::all_default() {
+        let light = match technique.light_kind() {
+            LightKind::Directional => &sun,
+            LightKind::Point => &lamp,
+            _ => continue,
+        };
+        let input = FitInput::new(camera, light, bounds, budget)
+            .with_eye_samples(&samples)
+            .with_pixels_per_radian(pixels_per_radian);
+        let t = Instant::now();
+        let shadow = fit(&technique, &input)?;
+        let fit_ms = ms_since(t);
+        let figures = (technique.name(), shadow.layer_side(), fit_ms);
+        rows.push(with_technique(&shadow, |t| {
+            frame.measure(&mut renderer, profiler, figures, t)
+        })??);
+    }
     Ok(rows)
 }
 
@@ -323,12 +253,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .triangles()
         .map(|t| t.map(DVec3::as_vec3))
         .collect();
-    let focus = SceneBounds::whole(scene.bounds().ok_or("empty scene")?);
     let camera = Camera::look_at(
         Vec3::new(10.0, 18.0, 120.0),
         Vec3::new(0.0, 4.0, 0.0),
         Vec3::Y,
-        Projection::perspective(60f32.to_radians(), WIDTH as f32 / HEIGHT as f32, 1.0, 500.0),
+        Projection::perspective(FOV_Y, WIDTH as f32 / HEIGHT as f32, 1.0, 500.0),
     )?;
     let frame = Frame {
         ctx: &ctx,
@@ -336,7 +265,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         camera: &camera,
         frames,
     };
-    let rows = measure_all(&frame, &mut profiler, &focus, &scene)?;
+    let rows = measure_all(&frame, &mut profiler, &scene)?;
     let out = if as_json {
         json(&ctx.describe(), &profiler, &rows)
     } else {

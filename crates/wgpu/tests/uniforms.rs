@@ -4,11 +4,12 @@
 use core::mem::{offset_of, size_of};
 
 use glam::{Mat4, Vec3};
-use shadowmap_frustum::{
-    Camera, CascadeOptions, CascadeSet, CascadeSplits, LightDirection, Projection, ShadowTransform,
-    SplitScheme,
+use shadowmap::frustum::{
+    Aabb, Camera, Light, LightDirection, Projection, SceneBounds, ShadowTransform,
 };
-use shadowmap_paraboloid::{MapOptions, ParaboloidMap, ParaboloidUniform};
+use shadowmap::paraboloid::{ParaboloidMap, ParaboloidUniform};
+use shadowmap::warp::LispsmOptions;
+use shadowmap::{CascadePlan, DpsmOptions, FitInput, Fitted, Technique, fit};
 use shadowmap_wgpu::shaders;
 use shadowmap_wgpu::uniforms::{
     CascadeShadowRaw, FrameRaw, MatrixShadowRaw, ParaboloidLayerRaw, RtwShadowRaw, ToRaw,
@@ -155,17 +156,29 @@ fn to_raw_copies_the_math_crates_outputs() {
         Projection::perspective(1.0, 1.5, 0.1, 100.0),
     )
     .unwrap();
-    let splits = CascadeSplits::new(&SplitScheme::Logarithmic, 3, 0.1, 100.0)
-        .unwrap()
+    // Three cascades of 512² (the only power-of-two side the budget offers),
+    // logarithmic splits with a 20% blend band, reversed-Z.
+    let plan = CascadePlan::default()
+        .with_max_cascades(3)
+        .with_split_lambda(1.0)
         .with_overlap(0.2)
-        .unwrap();
-    let set = CascadeSet::fit(
-        &camera,
-        Vec3::new(0.3, -1.0, 0.2),
-        &splits,
-        &CascadeOptions::default().with_reversed_z(true),
-    )
-    .unwrap();
+        .with_reversed_z(true);
+    let light = Light::Directional {
+        direction: Vec3::new(0.3, -1.0, 0.2),
+    };
+    let ground = Aabb::new(
+        Vec3::new(-100.0, -1.0, -110.0),
+        Vec3::new(100.0, 10.0, 10.0),
+    );
+    let input = FitInput::new(&camera, &light, SceneBounds::whole(ground), 3 * 512 * 512);
+    let Fitted::Cascades(set) = fit(&Technique::StableCascades(plan), &input)
+        .unwrap()
+        .fitted()
+        .clone()
+    else {
+        panic!("cascades expected");
+    };
+    let splits = set.splits.clone();
     let raw = set.to_raw();
     assert_eq!(raw.count, 3);
     assert_eq!(raw.reversed_z, 1);
@@ -191,20 +204,20 @@ fn to_raw_copies_the_math_crates_outputs() {
     assert_eq!(raw.with_selection_by_projection(f32::NAN, 0).margin_uv, 0.0);
     assert_eq!(cascade_layers(&set).len(), 3);
 
-    let map = ParaboloidMap::dual(
-        Vec3::new(1.0, 2.0, 3.0),
-        Vec3::NEG_Y,
-        0.5,
-        50.0,
-        &MapOptions::default(),
-    )
-    .unwrap();
-    let p = ToRaw::to_raw(&map);
-    let reference = ParaboloidMap::to_raw(&map);
+    let lamp = Light::Point {
+        position: Vec3::new(1.0, 2.0, 3.0),
+        range: 50.0,
+    };
+    let input = FitInput::new(&camera, &lamp, SceneBounds::whole(ground), 1 << 20);
+    let dpsm = Technique::Dpsm(DpsmOptions::default().with_near(0.5));
+    let shadow = fit(&dpsm, &input).unwrap();
+    let map = shadow.paraboloid().unwrap();
+    let p = ToRaw::to_raw(map);
+    let reference = ParaboloidMap::to_raw(map);
     assert_eq!(p.rotation, reference.rotation);
     assert_eq!(p.position_near, [1.0, 2.0, 3.0, 0.5]);
     assert_eq!(p.far_zoom_reversed_dual, [50.0, 1.0, 0.0, 1.0]);
-    let layers = paraboloid_layers(&map);
+    let layers = paraboloid_layers(map);
     assert_eq!(layers.len(), 2);
     assert_eq!((layers[0].side[0], layers[1].side[0]), (0.0, 1.0));
 
@@ -232,19 +245,26 @@ fn warped_cascade_blocks_carry_the_fits_bands_and_view_depth() {
         Projection::perspective(1.0, 1.5, 0.5, 200.0),
     )
     .unwrap();
-    let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.7 }, 3, 0.5, 200.0)
-        .unwrap()
-        .with_overlap(0.2)
-        .unwrap();
-    let scene = shadowmap_warp::SceneBounds::whole(shadowmap_frustum::Aabb::new(
+    let scene = SceneBounds::whole(Aabb::new(
         Vec3::new(-100.0, 0.0, -100.0),
         Vec3::new(100.0, 20.0, 100.0),
     ));
-    let light = Vec3::new(-0.7, -0.7, 0.2);
-    let options = shadowmap_warp::LispsmOptions::default().with_reversed_z(true);
-    let mut set =
-        shadowmap_warp::warped_cascades(&camera, light, &scene, &splits, &[0.0; 3], &options)
-            .unwrap();
+    let light = Light::Directional {
+        direction: Vec3::new(-0.7, -0.7, 0.2),
+    };
+    let technique = Technique::WarpedCascades {
+        plan: CascadePlan::default()
+            .with_max_cascades(3)
+            .with_split_lambda(0.7)
+            .with_overlap(0.2),
+        lispsm: LispsmOptions::default().with_reversed_z(true),
+    };
+    let input = FitInput::new(&camera, &light, scene, 3 * 512 * 512);
+    let Fitted::WarpedCascades { cascades, .. } = fit(&technique, &input).unwrap().fitted().clone()
+    else {
+        panic!("warped cascades expected");
+    };
+    let mut set = cascades;
     let view = camera.view_from_world().unwrap();
     let raw = CascadeShadowRaw::from_warped(&set, view);
     assert_eq!(
