@@ -15,32 +15,10 @@ use shadowmap::{
 };
 use shadowmap_testgen::arbitrary::Unstructured;
 use shadowmap_testgen::paraboloid::plan_input;
-use shadowmap_testgen::warp::{WarpCase, receiver_samples, warp_case};
+use shadowmap_testgen::warp::{WarpCase, f32_rounding, receiver_samples, warp_case};
 use shadowmap_testgen::{proptest_config, strategy};
 
 const BUDGET: u64 = 512 * 512;
-
-/// `f32` rounding of a matrix map at `p`, in uv / depth units (forward error bound of
-/// the homogeneous product and the division by `w`).
-fn rounding(t: &ShadowTransform, p: DVec3) -> f64 {
-    let m = t.uv_from_world.as_dmat4();
-    let h = p.extend(1.0);
-    let abs_row = |r: usize| {
-        (m.x_axis[r] * h.x).abs()
-            + (m.y_axis[r] * h.y).abs()
-            + (m.z_axis[r] * h.z).abs()
-            + m.w_axis[r].abs()
-    };
-    let hw = m * h;
-    let eps = 64.0 * f64::from(f32::EPSILON);
-    let w_err = eps * abs_row(3) / hw.w.abs();
-    let mut worst = 0.0f64;
-    for r in 0..3 {
-        let v = (hw[r] / hw.w).abs();
-        worst = worst.max(eps * abs_row(r) / hw.w.abs() + v * w_err);
-    }
-    1e-6 + worst
-}
 
 /// The matrix that maps `layer` of a matrix-based shadow (RTW: its base, whose warp
 /// keeps `[0, 1]` and clamps to the edge outside).
@@ -163,7 +141,7 @@ fn check_directional(case: &WarpCase, points: &[Vec3]) -> Result<usize, TestCase
         if fitted_xpsm && !casters_hold_receivers {
             continue;
         }
-        let tol = |layer, p| layer_transform(&shadow, layer).map_or(1e-4, |t| rounding(&t, p));
+        let tol = |layer, p| layer_transform(&shadow, layer).map_or(1e-4, |t| f32_rounding(&t, p));
         assert_inside(&shadow, points, &case.camera, tol)?;
         checked += 1;
     }
@@ -295,7 +273,7 @@ fn depth_bounds_shrink_the_cascades_to_the_samples() {
         },
     ] {
         let shadow = fit(&technique, &input).unwrap();
-        let tol = |layer, p| layer_transform(&shadow, layer).map_or(1e-4, |t| rounding(&t, p));
+        let tol = |layer, p| layer_transform(&shadow, layer).map_or(1e-4, |t| f32_rounding(&t, p));
         assert_inside(&shadow, &near, &camera, tol).unwrap();
         // Nothing beyond the bounds is mapped: the cascades end there.
         let far = camera.eye() + camera.forward() * (bounds.max * 1.5);
@@ -328,7 +306,7 @@ fn spot_fit_covers_the_lit_view() {
         .collect();
     assert!(lit.len() > 3);
     let t = *shadow.transform().unwrap();
-    assert_inside(&shadow, &lit, &camera, |_, p| rounding(&t, p)).unwrap();
+    assert_inside(&shadow, &lit, &camera, |_, p| f32_rounding(&t, p)).unwrap();
 }
 
 #[test]

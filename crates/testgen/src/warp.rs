@@ -290,3 +290,28 @@ pub fn check_cascades(case: &WarpCase) -> Result<usize, WarpError> {
     }
     r.map(|c| c.cascades.len())
 }
+
+/// Bound on the `f32` rounding of `uv_from_world * p` in uv / depth units (a dot
+/// product of four terms per row, then the division by `w`), for checks that a point
+/// lands inside the map "up to `f32` rounding": `64 eps Σ|m_ij p_j| / w` per coordinate, plus the
+/// error of `w` carried through the division.
+#[must_use]
+pub fn f32_rounding(t: &ShadowTransform, p: DVec3) -> f64 {
+    let m = t.uv_from_world.as_dmat4();
+    let h = p.extend(1.0);
+    let abs_row = |r: usize| {
+        (m.x_axis[r] * h.x).abs()
+            + (m.y_axis[r] * h.y).abs()
+            + (m.z_axis[r] * h.z).abs()
+            + m.w_axis[r].abs()
+    };
+    let hw = m * h;
+    let eps = 64.0 * f64::from(f32::EPSILON);
+    let w_err = eps * abs_row(3) / hw.w.abs();
+    let mut worst = 0.0f64;
+    for r in 0..3 {
+        let v = (hw[r] / hw.w).abs();
+        worst = worst.max(eps * abs_row(r) / hw.w.abs() + v * w_err);
+    }
+    1e-6 + worst
+}

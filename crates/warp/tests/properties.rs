@@ -9,40 +9,17 @@ use shadowmap_testgen::arbitrary;
 use shadowmap_testgen::strategy;
 use shadowmap_testgen::warp::{
     WarpCase, check_cascades, check_lispsm, check_transform, check_tsm, check_uniform, check_xpsm,
-    receiver_samples, warp_case, warp_case_raw,
+    f32_rounding, receiver_samples, warp_case, warp_case_raw,
 };
 use shadowmap_warp::{
     LispsmOptions, UniformOptions, WarpError, XpsmOptions, light_frame, lispsm, uniform_focused,
     warped_cascades, xpsm,
 };
 
-/// Bound on the `f32` rounding of `uv_from_world * p` (a dot product of four terms per
-/// row, then the division by `w`): `64 eps Σ|m_ij p_j| / w` per coordinate, plus the
-/// error of `w` carried through the division.
-fn rounding(t: &ShadowTransform, p: DVec3) -> f64 {
-    let m = t.uv_from_world.as_dmat4();
-    let h = p.extend(1.0);
-    let abs_row = |r: usize| {
-        (m.x_axis[r] * h.x).abs()
-            + (m.y_axis[r] * h.y).abs()
-            + (m.z_axis[r] * h.z).abs()
-            + m.w_axis[r].abs()
-    };
-    let hw = m * h;
-    let eps = 64.0 * f64::from(f32::EPSILON);
-    let w_err = eps * abs_row(3) / hw.w.abs();
-    let mut worst = 0.0f64;
-    for r in 0..3 {
-        let v = (hw[r] / hw.w).abs();
-        worst = worst.max(eps * abs_row(r) / hw.w.abs() + v * w_err);
-    }
-    1e-6 + worst
-}
-
 /// Every visible receiver lands in `[0, 1]²` with depth in `[0, 1]`; every caster
 /// point above a visible receiver (toward the light, inside the caster box) lies in
 /// the depth range, nearer the light than the receiver. Up to `f32` rounding
-/// ([`rounding`]).
+/// ([`f32_rounding`]).
 fn assert_covers(case: &WarpCase, t: &ShadowTransform, bytes: &[u8]) -> Result<(), TestCaseError> {
     let mut u = Unstructured::new(bytes);
     let Some(samples) = receiver_samples(case, &mut u) else {
@@ -63,7 +40,7 @@ fn assert_covers_samples(
         let s = t.map_point(p.as_dvec3());
         prop_assert!(s.is_some(), "receiver {p} not mapped");
         let s = s.unwrap();
-        let tol = rounding(t, p.as_dvec3());
+        let tol = f32_rounding(t, p.as_dvec3());
         let inside = |x: f64| (-tol..=1.0 + tol).contains(&x);
         prop_assert!(
             inside(s.uv.x) && inside(s.uv.y),
@@ -98,7 +75,7 @@ fn assert_covers_samples(
             let sc = t.map_point(c);
             prop_assert!(sc.is_some(), "caster {c} not mapped");
             let sc = sc.unwrap();
-            let tol = tol + rounding(t, c);
+            let tol = tol + f32_rounding(t, c);
             let inside = |x: f64| (-tol..=1.0 + tol).contains(&x);
             prop_assert!(
                 inside(sc.depth),
@@ -234,7 +211,7 @@ fn check_motion(
         }
         let moved = (x.uv - y.uv).abs().max_element();
         let bound = 16.0 * (delta + theta) * diam * max_stretch
-            + 4.0 * (rounding(&a, p) + rounding(&b, p))
+            + 4.0 * (f32_rounding(&a, p) + f32_rounding(&b, p))
             + 8.0 / RES;
         prop_assert!(
             moved <= bound,
@@ -362,7 +339,7 @@ proptest! {
         prop_assert!(l.n.is_infinite());
         let mut un = Unstructured::new(&b);
         for p in receiver_samples(&case, &mut un).unwrap_or_default() {
-            let tol = 4.0 * rounding(&u, p.as_dvec3());
+            let tol = 4.0 * f32_rounding(&u, p.as_dvec3());
             let (a, c) = (u.map_point(p.as_dvec3()).unwrap(), l.transform.map_point(p.as_dvec3()).unwrap());
             prop_assert!((a.uv - c.uv).abs().max_element() < tol, "{:?} vs {:?}", a.uv, c.uv);
             prop_assert!((a.depth - c.depth).abs() < tol);
