@@ -524,8 +524,8 @@ pub fn mesh_configuration(
 ///
 /// A draw that would measure little (a camera inside a building or facing the sky,
 /// a light that reaches nothing it sees) is drawn again, up to 32 times: on a
-/// 16×9 preview at least half the pixels must see a surface and a quarter one lit
-/// from the front.
+/// 16×9 preview at least half the pixels must see a surface and a quarter one the
+/// light reaches (inside a spot's cone, within range) and lights from the front.
 ///
 /// Case `k` of a scene has a directional light when `k % 3 == 0`, a spot light when
 /// `k % 3 == 1` and a point light otherwise. The camera stands anywhere over the
@@ -533,10 +533,13 @@ pub fn mesh_configuration(
 /// (at least 1), looking in any horizontal direction, 50° down to 5° up; near
 /// plane 0.1 to 1, far plane 1.2 times the scene's diagonal. A directional light
 /// comes from anywhere above (a third of them within 15° of the view direction,
-/// where warps must fall back to the uniform fit); a spot light hangs above the
-/// scene aimed at a random point of its lower half, half-angle 25° to 60°; a point
-/// light stands over the footprint, 1 m to half the scene's height up. The draws
-/// depend only on `options.seed`, the scene and `k`.
+/// where warps must fall back to the uniform fit); a spot light hangs 0.2 to 1
+/// local extents above the region ahead of the camera (the local extent is the
+/// scene's larger horizontal side clamped to 4..80 m), aimed at a point of that
+/// region between the floor and the eye, half-angle 25° to 60°; a point light stands
+/// over that region, 1 m to half the scene's height above the floor. The draws
+/// of case `k` depend only on `options.seed`, the scene and `k` (one random stream
+/// per case).
 ///
 /// # Errors
 /// [`EvalError::InvalidView`] as [`CameraPath::sample`]; the BVH's errors for a
@@ -557,13 +560,16 @@ pub fn sweep_configurations(
             continue;
         };
         let (min, max) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
-        let mut rng = SplitMix64::new(options.seed ^ (0x5EE9_0000_0000 + s as u64));
         let bvh = Bvh::build(&scene.mesh)?;
         for k in 0..count {
+            // One stream per case: a case does not change when another one needs more
+            // draws, or when `count` changes.
+            let mut rng =
+                SplitMix64::new(options.seed ^ (0x5EE9_0000_0000 + s as u64) ^ ((k as u64) << 40));
             let mut attempts = 0;
             let (path, forward, light, cameras) = loop {
                 let (path, forward) = sweep_camera(&mut rng, min, max);
-                let light = sweep_light(&mut rng, k, min, max, forward);
+                let light = sweep_light(&mut rng, k, (min, max), (path.eye, forward));
                 let cameras = path.sample(1, options.aspect)?;
                 attempts += 1;
                 if attempts >= SWEEP_ATTEMPTS || measurable(&bvh, &cameras[0], &light)? {
@@ -605,17 +611,39 @@ fn measurable(bvh: &Bvh, camera: &Camera, light: &Light) -> Result<bool, EvalErr
         .iter()
         .flatten()
         .filter(|s| {
-            is_front_lit(
-                light,
-                &SurfacePoint {
-                    position: s.position,
-                    normal: s.normal,
-                },
-            )
+            reaches(light, s.position)
+                && is_front_lit(
+                    light,
+                    &SurfacePoint {
+                        position: s.position,
+                        normal: s.normal,
+                    },
+                )
         })
         .count();
     let pixels = (w * h) as usize;
     Ok(2 * gbuffer.visible_count() >= pixels && 4 * front_lit >= pixels)
+}
+
+/// Whether `light` reaches `world`: inside a spot light's cone and range, a point
+/// light's range; a directional light reaches everything.
+fn reaches(light: &Light, world: DVec3) -> bool {
+    match *light {
+        Light::Directional { .. } => true,
+        Light::Point { position, range } => world.distance(position.as_dvec3()) <= f64::from(range),
+        Light::Spot {
+            position,
+            direction,
+            half_angle,
+            range,
+        } => {
+            let to = world - position.as_dvec3();
+            let distance = to.length();
+            distance <= f64::from(range)
+                && to.dot(direction.as_dvec3().normalize_or_zero())
+                    >= distance * f64::from(half_angle).cos()
+        }
+    }
 }
 
 fn sweep_camera(rng: &mut SplitMix64, min: DVec3, max: DVec3) -> (CameraPath, DVec3) {
@@ -647,7 +675,12 @@ fn sweep_camera(rng: &mut SplitMix64, min: DVec3, max: DVec3) -> (CameraPath, DV
     (path, forward)
 }
 
-fn sweep_light(rng: &mut SplitMix64, k: usize, min: DVec3, max: DVec3, forward: DVec3) -> Light {
+fn sweep_light(
+    rng: &mut SplitMix64,
+    k: usize,
+    (min, max): (DVec3, DVec3),
+    (eye, forward): (DVec3, DVec3),
+) -> Light {
     let size = max - min;
     let range = (2.0 * size.length()) as f32;
     match k % 3 {
@@ -682,15 +715,19 @@ fn sweep_light(rng: &mut SplitMix64, k: usize, min: DVec3, max: DVec3, forward: 
             directional(direction)
         }
         1 => {
+            // Above the region the camera looks at, aimed at a point of it between
+            // the floor and the eye.
+            let focus = view_focus(eye, forward, min, max);
+            let reach = local_extent(min, max);
             let position = DVec3::new(
-                rng.range(min.x, max.x),
-                max.y + size.length() * rng.range(0.1, 0.5),
-                rng.range(min.z, max.z),
+                focus.x + reach * rng.range(-0.5, 0.5),
+                eye.y.max(min.y) + reach * rng.range(0.2, 1.0),
+                focus.z + reach * rng.range(-0.5, 0.5),
             );
             let target = DVec3::new(
-                rng.range(min.x, max.x),
-                min.y + 0.5 * size.y * rng.range(0.0, 1.0),
-                rng.range(min.z, max.z),
+                focus.x + reach * rng.range(-0.5, 0.5),
+                min.y + (eye.y - min.y).max(0.0) * rng.range(0.0, 1.0),
+                focus.z + reach * rng.range(-0.5, 0.5),
             );
             Light::Spot {
                 position: position.as_vec3(),
@@ -699,16 +736,41 @@ fn sweep_light(rng: &mut SplitMix64, k: usize, min: DVec3, max: DVec3, forward: 
                 range,
             }
         }
-        _ => Light::Point {
-            position: DVec3::new(
-                rng.range(min.x, max.x),
-                min.y + rng.range(1.0, (0.5 * size.y).max(2.0)),
-                rng.range(min.z, max.z),
-            )
-            .as_vec3(),
-            range,
-        },
+        _ => {
+            // Over the region the camera looks at, 1 m to half the scene's height
+            // above the eye's floor level.
+            let focus = view_focus(eye, forward, min, max);
+            let reach = local_extent(min, max);
+            Light::Point {
+                position: DVec3::new(
+                    focus.x + reach * rng.range(-0.5, 0.5),
+                    min.y + rng.range(1.0, (0.5 * size.y).max(2.0)),
+                    focus.z + reach * rng.range(-0.5, 0.5),
+                )
+                .as_vec3(),
+                range,
+            }
+        }
     }
+}
+
+/// The horizontal extent of the neighbourhood a sweep camera looks at: the scene's
+/// larger horizontal side, at least 4 m and at most 80 m (a 1 km terrain is not
+/// lit by one spot light).
+fn local_extent(min: DVec3, max: DVec3) -> f64 {
+    (max.x - min.x).max(max.z - min.z).clamp(4.0, 80.0)
+}
+
+/// Half the local extent ahead of the eye along the horizontal view direction,
+/// kept over the scene's footprint.
+fn view_focus(eye: DVec3, forward: DVec3, min: DVec3, max: DVec3) -> DVec3 {
+    let level = DVec3::new(forward.x, 0.0, forward.z).normalize_or(DVec3::X);
+    let ahead = eye + level * (0.5 * local_extent(min, max));
+    DVec3::new(
+        ahead.x.clamp(min.x, max.x),
+        eye.y,
+        ahead.z.clamp(min.z, max.z),
+    )
 }
 
 fn describe_light(light: &Light) -> String {
@@ -766,5 +828,32 @@ mod tests {
         let turn = cams[2].forward().dot(cams[0].forward()).acos().to_degrees();
         assert!((turn - 10.0).abs() < 1e-3);
         assert!(p.sample(0, 1.5).is_err());
+    }
+
+    #[test]
+    fn sweep_cases_are_independent_and_lit() {
+        let options = ConfigOptions::default().with_seed(7);
+        let (three, six) = (
+            sweep_configurations(&options, 3).unwrap(),
+            sweep_configurations(&options, 6).unwrap(),
+        );
+        // Case k is the same whatever the count.
+        for case in &three {
+            let same = six.iter().find(|c| c.name == case.name).unwrap();
+            assert_eq!(case.description, same.description);
+        }
+        // Every spot and point case reaches a quarter of what its camera sees.
+        for case in six
+            .iter()
+            .filter(|c| !matches!(c.light, Light::Directional { .. }))
+        {
+            let bvh = Bvh::build(&case.scene.mesh).unwrap();
+            assert!(
+                measurable(&bvh, &case.path[0], &case.light).unwrap(),
+                "{}: {}",
+                case.name,
+                case.description
+            );
+        }
     }
 }
