@@ -234,12 +234,13 @@ impl Focus {
 pub(crate) fn focus(view: &View, light: Vec3, scene: &SceneBounds) -> Result<Focus, WarpError> {
     let dir = light_unit(light)?;
     let (receivers, casters) = check_scene(scene)?;
-    let body = ConvexBody::from_frustum_aabb(&view.frustum, &receivers)?;
+    // The vertices of the body alone: its planes are not needed here.
+    let body = ConvexBody::frustum_aabb_vertices(&view.frustum, &receivers)?;
     if body.is_empty() {
         return Err(WarpError::NoVisibleReceivers);
     }
     let (rot, sin_gamma) = frame(dir, view.forward, view.up);
-    let receivers: Points = body.vertices().iter().map(|v| v.as_dvec3()).collect();
+    let receivers: Points = body.iter().map(|v| v.as_dvec3()).collect();
     let casters = caster_points(&rot, &receivers, &casters);
     Ok(Focus {
         light: dir,
