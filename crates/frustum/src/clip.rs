@@ -37,6 +37,24 @@ const FRUSTUM_EDGES: [(usize, usize); 12] = [
     (3, 7),
 ];
 
+/// The planes (left, right, bottom, top, near, far) that end each edge of
+/// [`FRUSTUM_EDGES`] at its first and at its second corner: the one plane of the
+/// corner that does not hold the edge.
+const EDGE_END_PLANES: [(usize, usize); 12] = [
+    (0, 1),
+    (2, 3),
+    (1, 0),
+    (3, 2),
+    (0, 1),
+    (2, 3),
+    (1, 0),
+    (3, 2),
+    (4, 5),
+    (4, 5),
+    (4, 5),
+    (4, 5),
+];
+
 /// A frustum (its corners and inward planes) and a box (`lo`, `hi`), with the
 /// tolerances of [`ConvexBody`](crate::ConvexBody): a point counts as inside a plane
 /// within `inside_tol`, and points closer than `merge_tol` (in every coordinate) are
@@ -132,10 +150,15 @@ impl FrustumBox<'_> {
     }
 
     /// Points where a frustum edge's line crosses a box face, inside the box; past the
-    /// edge's ends only when inside the frustum as well.
+    /// edge's ends only when inside the frustum as well. Past end `p` the line leaves
+    /// the frustum through the plane that ends the edge there, at a rate of `L` (the
+    /// other end's distance from that plane) per unit of the edge parameter, so only
+    /// crossings within `tol / L` of an end can pass (twice that is tried).
     fn frustum_edges(&self, c: &[DVec3; 8], push: &mut impl FnMut(DVec3)) {
-        for (i, j) in FRUSTUM_EDGES {
+        for ((i, j), (end_i, end_j)) in FRUSTUM_EDGES.into_iter().zip(EDGE_END_PLANES) {
             let (p, q) = (c[i], c[j]);
+            let before = -2.0 * self.inside_tol / self.planes[end_i].distance(q);
+            let after = 1.0 + 2.0 * self.inside_tol / self.planes[end_j].distance(p);
             for axis in 0..3 {
                 for v in [self.lo[axis], self.hi[axis]] {
                     let (dp, dq) = (p[axis] - v, q[axis] - v);
@@ -143,9 +166,14 @@ impl FrustumBox<'_> {
                         continue;
                     }
                     let t = dp / (dp - dq);
+                    let on_edge = (0.0..=1.0).contains(&t);
+                    // Written so that NaN bounds (an edge of length 0) skip too.
+                    if !(on_edge || (t >= before && t <= after)) {
+                        continue;
+                    }
                     let mut x = p + (q - p) * t;
                     x[axis] = v;
-                    if self.in_box(x) && ((0.0..=1.0).contains(&t) || self.in_frustum(x)) {
+                    if self.in_box(x) && (on_edge || self.in_frustum(x)) {
                         push(x);
                     }
                 }
@@ -154,23 +182,31 @@ impl FrustumBox<'_> {
     }
 
     /// Points where a box edge's line crosses a frustum face, inside the frustum and
-    /// (past the edge's ends) the box.
+    /// (past the edge's ends, by at most twice the tolerance) the box. The distances
+    /// of a point of the edge to the frustum planes are interpolated from its ends'.
     fn box_edges(&self, bc: &[DVec3; 8], dist: &[[f64; 6]; 8], push: &mut impl FnMut(DVec3)) {
-        for i in 0..8 {
-            for axis in 0..3 {
+        for axis in 0..3 {
+            let slack = 2.0 * self.inside_tol / (self.hi[axis] - self.lo[axis]);
+            for i in (0..8).filter(|i| i & 1 << axis == 0) {
                 let j = i | 1 << axis;
-                if j == i {
-                    continue;
-                }
                 for (di, dj) in dist[i].iter().zip(&dist[j]) {
                     if di == dj {
                         continue;
                     }
                     let t = di / (di - dj);
-                    let mut x = bc[i];
-                    x[axis] += (bc[j][axis] - bc[i][axis]) * t;
-                    if ((0.0..=1.0).contains(&t) || self.in_box(x)) && self.in_frustum(x) {
-                        push(x);
+                    if !(t >= -slack && t <= 1.0 + slack) {
+                        continue;
+                    }
+                    let inside = dist[i]
+                        .iter()
+                        .zip(&dist[j])
+                        .all(|(a, b)| a + (b - a) * t >= -self.inside_tol);
+                    if inside {
+                        let mut x = bc[i];
+                        x[axis] += (bc[j][axis] - bc[i][axis]) * t;
+                        if self.in_box(x) {
+                            push(x);
+                        }
                     }
                 }
             }
@@ -182,23 +218,21 @@ impl FrustumBox<'_> {
     /// its tolerance (the eye of a frustum with a tiny near face). Tried only when a
     /// corner on one of the two lies that close to the other.
     fn opposite_planes(&self, c: &[DVec3; 8], push: &mut impl FnMut(DVec3)) {
-        let all: ArrayVec<DPlane, 12> = self
-            .planes
-            .iter()
-            .copied()
-            .chain(box_planes(self.lo, self.hi))
-            .collect();
         let near = 16.0 * self.inside_tol;
         for i in (0..6).step_by(2) {
-            let (a, b) = (&all[i], &all[i + 1]);
+            let (a, b) = (&self.planes[i], &self.planes[i + 1]);
             let ab = a.normal.cross(b.normal);
-            if ab.length_squared() < 1e-24 || !c.iter().any(|p| b.distance(*p) <= near) {
+            let close = c.iter().any(|p| a.distance(*p) + b.distance(*p) <= near);
+            if !close || ab.length_squared() < 1e-24 {
                 continue;
             }
-            for (k, k_plane) in all.iter().enumerate() {
-                if k == i || k == i + 1 {
-                    continue;
-                }
+            let others = self
+                .planes
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| k / 2 != i / 2);
+            let box_planes = box_planes(self.lo, self.hi);
+            for k_plane in others.map(|(_, pl)| pl).chain(&box_planes) {
                 let ca = k_plane.normal.cross(a.normal);
                 if let Some(x) = intersect3(a, b, k_plane, ca, ab)
                     && self.in_frustum(x)
