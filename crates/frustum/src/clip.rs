@@ -16,8 +16,11 @@ use glam::{DVec3, Vec3};
 
 use crate::geometry::DPlane;
 
-/// Most vertices [`frustum_box`] reports: an intersection of two hexahedra has at most
-/// `2 * 12 - 4 = 20`; the rest is room for rounding.
+/// Most vertices of a frustum ∩ box that [`ConvexBody::frustum_aabb_vertices`]
+/// reports: an intersection of two hexahedra has at most `2 * 12 - 4 = 20`; the rest
+/// is room for rounding.
+///
+/// [`ConvexBody::frustum_aabb_vertices`]: crate::ConvexBody::frustum_aabb_vertices
 pub const MAX_FRUSTUM_AABB_VERTICES: usize = 32;
 
 /// Corner index pairs of a frustum's 12 edges (corners in [`Frustum`](crate::Frustum)

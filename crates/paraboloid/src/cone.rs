@@ -324,7 +324,7 @@ fn min_norm_support(dirs: &[DVec3]) -> Option<DVec3> {
             .map(|(i, d)| (i, (*d - dirs[0]).dot(v)))
             .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
         let gap = v - dirs[w];
-        if gap.dot(v) <= 1e-15 * gap.length() * vv.sqrt() || support.contains(&w) {
+        if gap.dot(v) <= 1e-15 * gap.length() * v.length() || support.contains(&w) {
             return Some(v);
         }
         support.push(w);
