@@ -177,21 +177,31 @@ const RIM_BAND: f64 = 1e-5;
 /// of the directions, and `cos(half_angle) = |p*|` (minimax duality). `p*` is the
 /// minimum-norm point of the affine hull of its support set (one, two or three
 /// directions on the rim of the cone: it lies on a face of the hull, with positive
-/// barycentric weights). Gilbert's iteration ([`min_norm_support`]) finds `p*` to
-/// rounding; the support set is then searched among the directions on the rim of
-/// that cone (within [`RIM_BAND`]), usually two or three, where the closed forms of
-/// the subsets (the direction itself, the midpoint of a pair, the circumcentre of a
-/// triangle) are exact to rounding even where the iteration's point is not (a sliver
-/// triangle of nearly equal directions). The paper's axis is a candidate too, so the
+/// barycentric weights). Gilbert's iteration ([`min_norm_support`]) finds `p*` and
+/// its support set; the closed form of the support set's point (the direction itself,
+/// the midpoint of a pair, the circumcentre of a triangle) is exact to rounding, and
+/// when its cone holds every direction it is the answer (the usual case, certified by
+/// one pass over the directions). Where the iteration's point is not exact (a sliver
+/// triangle of nearly equal and nearly opposite directions) the support set is
+/// searched among the directions on the rim of its cone (within [`RIM_BAND`]),
+/// usually a few, or among all of them within that band of 90 degrees. The paper's axis is a candidate too, so the
 /// result is never wider than the paper's cone: of the candidates, the one with the
 /// largest smallest cosine wins.
 pub(crate) fn minimal_fit(dirs: &[DVec3]) -> Option<DCone> {
     // The origin in the hull (or within 1e-12 of it: a cone wider than
     // `NO_CONE_ANGLE` in any case): no cone.
-    let v = min_norm_support(dirs)?;
+    let (v, support) = min_norm_support(dirs)?;
     let mut best = Best::new(dirs);
     best.consider(dirs.iter().copied().sum());
     best.consider(v);
+    // The support set's own cone (its closed form) is the minimal cone when it holds
+    // every direction: its cosine to each is at least `|p|`, the cosine to the
+    // support (to rounding: the half-angle is then optimal to `1e-15 / sin h`).
+    if let Some(p) = support_point(dirs, &support)
+        && best.consider(p) >= p.length() * (1.0 - 1e-15)
+    {
+        return best.cone();
+    }
     if best.cos > RIM_BAND {
         let rim: ArrayVec<DVec3, MAX_CONE_DIRECTIONS> = dirs
             .iter()
@@ -205,6 +215,19 @@ pub(crate) fn minimal_fit(dirs: &[DVec3]) -> Option<DCone> {
         best.search_subsets(dirs);
     }
     best.cone()
+}
+
+/// The minimum-norm point of the affine hull of a support set in closed form (the
+/// direction, the midpoint of a pair, the circumcentre of a triangle), `None` for a
+/// triangle whose point falls outside it.
+fn support_point(dirs: &[DVec3], support: &Support) -> Option<DVec3> {
+    let d = |k: usize| dirs[support[k]];
+    match support.len() {
+        1 => Some(d(0)),
+        2 => Some(0.5 * (d(0) + d(1))),
+        3 => triangle_min_norm(d(0), d(1), d(2), f64::NEG_INFINITY),
+        _ => None,
+    }
 }
 
 /// The best axis so far of a minimal-cone search: the one with the largest smallest
@@ -225,10 +248,11 @@ impl<'a> Best<'a> {
     }
 
     /// Scores the axis along `p` (any length; ignored when zero or not finite).
-    fn consider(&mut self, p: DVec3) {
+    /// Returns the smallest cosine of that axis (`-inf` when ignored).
+    fn consider(&mut self, p: DVec3) -> f64 {
         let len = p.length();
         if !(len > 1e-15 && len.is_finite()) {
-            return;
+            return f64::NEG_INFINITY;
         }
         let axis = p / len;
         let min_cos = self
@@ -240,6 +264,7 @@ impl<'a> Best<'a> {
             self.cos = min_cos;
             self.axis = axis;
         }
+        min_cos
     }
 
     /// Scores the axes of the minimum-norm points of every subset of one to three of
@@ -295,7 +320,8 @@ type Support = arrayvec::ArrayVec<usize, 4>;
 
 /// The minimum-norm point `v` of the convex hull of unit directions by Gilbert's
 /// iteration (the distance algorithm of Gilbert, Johnson and Keerthi, with the origin
-/// as the query point). `None` when the origin lies in the hull: inside a tetrahedron
+/// as the query point), with its support set (the one to three directions whose
+/// hull holds it). `None` when the origin lies in the hull: inside a tetrahedron
 /// of directions by more than `1e-9`, or within `1e-12` of the iteration's point (no
 /// cone under 90 degrees either way; nearer the hull's boundary the point is returned,
 /// as good as rounding allows).
@@ -306,7 +332,7 @@ type Support = arrayvec::ArrayVec<usize, 4>;
 /// every direction, measured by angle so that it holds its precision however small
 /// the hull), and otherwise replaces `v` by the point of `conv(support + w)` nearest
 /// the origin, keeping only the directions that point needs.
-fn min_norm_support(dirs: &[DVec3]) -> Option<DVec3> {
+fn min_norm_support(dirs: &[DVec3]) -> Option<(DVec3, Support)> {
     let mut support = Support::new();
     support.push(0);
     let mut v = dirs[0];
@@ -325,12 +351,12 @@ fn min_norm_support(dirs: &[DVec3]) -> Option<DVec3> {
             .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
         let gap = v - dirs[w];
         if gap.dot(v) <= 1e-15 * gap.length() * v.length() || support.contains(&w) {
-            return Some(v);
+            return Some((v, support));
         }
         support.push(w);
         v = nearest_on_simplex(dirs, &mut support)?;
     }
-    Some(v)
+    Some((v, support))
 }
 
 /// The point of the simplex `conv(dirs[support])` (two to four points) nearest the
