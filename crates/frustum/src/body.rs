@@ -477,8 +477,9 @@ mod tests {
     proptest! {
         #![proptest_config(shadowmap_testgen::proptest_config())]
 
-        /// The two-hexahedra path finds the vertices the search over every triple of
-        /// planes finds, each within the merge tolerance of one of the other's.
+        /// The frustum-box clip (edge crossings) finds the vertices the search over
+        /// every triple of planes finds, each within the merge tolerance of one of the
+        /// other's.
         #[test]
         fn hexahedra_path_matches_every_triple(case in strategy(body_case)) {
             let camera = local(&case.camera);
