@@ -4,7 +4,9 @@
 //! XPSM, TSM, four warped cascades, the spot fit, the IPSM plan with the paper's and
 //! the exact cone, RTW warp tables from a 1-D importance, and camera validation; the
 //! cascade fits and the four single-frustum warps also from a camera validated once
-//! per frame (`ValidCamera`). Besides criterion's figures it prints one table: each
+//! per frame (`ValidCamera`), and the focus body alone with each warp fitted from a
+//! body built once (`FocusBody`: what a frame pays per technique once the body is
+//! shared). Besides criterion's figures it prints one table: each
 //! builder's time per call (the fastest of many short batches, see
 //! `support/timing.rs`) and its ratio to Bevy's 4 cascades. `BUILDERS_ONLY` runs one
 //! builder for instruction counting (see `only`).
@@ -46,6 +48,8 @@ struct Frame {
     bounds: DepthBounds,
     importance: ImportanceMap,
     valid: ValidCamera,
+    /// The focus body of `valid`, built once (the per-frame share of every warp).
+    body: FocusBody,
 }
 
 fn frame() -> Frame {
@@ -107,11 +111,12 @@ fn frame() -> Frame {
         },
         importance,
         valid: ValidCamera::new(&camera).unwrap(),
+        body: FocusBody::new(&camera, light, &scene).unwrap(),
     }
 }
 
 /// The builders, by name.
-const NAMES: [&str; 16] = [
+const NAMES: [&str; 21] = [
     "bevy_cascades_4",
     "uniform_focused",
     "stable_cascades_4",
@@ -128,6 +133,11 @@ const NAMES: [&str; 16] = [
     "stable_cascades_4_valid",
     "tight_cascades_4_valid",
     "focus_body_valid_all_4",
+    "focus_body_valid",
+    "uniform_from_body",
+    "lispsm_from_body",
+    "xpsm_from_body",
+    "tsm_from_body",
 ];
 
 /// Runs builder `which` once on `f` (`warps` is the RTW output buffer).
@@ -202,6 +212,29 @@ fn run(f: &Frame, warps: &mut WarpMaps, which: usize) {
             black_box(body.lispsm(&LispsmOptions::default()).unwrap());
             black_box(body.xpsm(&XpsmOptions::default()).unwrap());
             black_box(body.tsm(&TsmOptions::default()).unwrap());
+        }
+        16 => {
+            black_box(FocusBody::new_valid(black_box(&f.valid), light, &f.scene).unwrap());
+        }
+        17 => {
+            black_box(
+                black_box(&f.body)
+                    .uniform(&UniformOptions::default())
+                    .unwrap(),
+            );
+        }
+        18 => {
+            black_box(
+                black_box(&f.body)
+                    .lispsm(&LispsmOptions::default())
+                    .unwrap(),
+            );
+        }
+        19 => {
+            black_box(black_box(&f.body).xpsm(&XpsmOptions::default()).unwrap());
+        }
+        20 => {
+            black_box(black_box(&f.body).tsm(&TsmOptions::default()).unwrap());
         }
         _ => unreachable!("no builder {which}"),
     }

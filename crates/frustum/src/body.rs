@@ -1,6 +1,7 @@
 use arrayvec::ArrayVec;
 use glam::{DVec3, Vec3};
 
+use crate::clip::{FrustumBox, MAX_FRUSTUM_AABB_VERTICES, intersect3};
 use crate::geometry::DPlane;
 use crate::{Aabb, Frustum, FrustumError};
 
@@ -37,7 +38,26 @@ impl ConvexBody {
     /// [`FrustumError::NonFinite`], [`FrustumError::EmptyBounds`] for an inverted box
     /// or a frustum without volume.
     pub fn from_frustum_aabb(frustum: &Frustum, aabb: &Aabb) -> Result<Self, FrustumError> {
-        Self::from_planes_aabb(&frustum.dplanes()?, &frustum.corners, aabb)
+        let planes = frustum.dplanes()?;
+        Self::from_frustum_parts(&planes, &frustum.corners.map(Vec3::as_dvec3), aabb)
+    }
+
+    /// The vertices of `frustum ∩ aabb` alone, as [`ConvexBody::from_frustum_aabb`]
+    /// finds them (the same points in the same order), without the bounding planes:
+    /// what a fit needs of the body, in a small fixed array.
+    ///
+    /// # Errors
+    /// As [`ConvexBody::from_frustum_aabb`].
+    pub fn frustum_aabb_vertices(
+        frustum: &Frustum,
+        aabb: &Aabb,
+    ) -> Result<ArrayVec<Vec3, MAX_FRUSTUM_AABB_VERTICES>, FrustumError> {
+        let planes = frustum.dplanes()?;
+        let corners = frustum.corners.map(Vec3::as_dvec3);
+        let aabb = aabb.validate()?;
+        let mut out = ArrayVec::new();
+        frustum_clip(&planes, &corners, &aabb).vertices(&mut out);
+        Ok(out)
     }
 
     /// The body from a frustum's exact `f64` corners (the builders' path: no `f32`
@@ -47,7 +67,27 @@ impl ConvexBody {
         aabb: &Aabb,
     ) -> Result<Self, FrustumError> {
         let planes = crate::frustum::dplanes(corners, 0.0)?;
-        Self::from_planes_aabb(&planes, &corners.map(DVec3::as_vec3), aabb)
+        Self::from_frustum_parts(&planes, corners, aabb)
+    }
+
+    /// `frustum ∩ aabb` from the frustum's planes and corners (see [`crate::clip`]).
+    fn from_frustum_parts(
+        fplanes: &[DPlane; 6],
+        corners: &[DVec3; 8],
+        aabb: &Aabb,
+    ) -> Result<Self, FrustumError> {
+        let aabb = aabb.validate()?;
+        let clip = frustum_clip(fplanes, corners, &aabb);
+        let mut planes = ArrayVec::new();
+        planes.extend(fplanes.iter().copied());
+        planes.extend(aabb.planes().iter().map(DPlane::from_plane));
+        let mut body = Self {
+            vertices: ArrayVec::new(),
+            planes,
+            scale: clip.scale,
+        };
+        clip.vertices(&mut body.vertices);
+        Ok(body)
     }
 
     /// `planes ∩ aabb` for any six planes bounding a convex region; `corners` set the
@@ -374,6 +414,34 @@ impl ConvexBody {
     }
 }
 
+/// The clip of a frustum (planes and corners) by a checked box, with the tolerances
+/// of [`ConvexBody::from_planes`]: the rounding scale is the largest coordinate of the
+/// frustum's `f32` corners and the box.
+fn frustum_clip<'a>(
+    planes: &'a [DPlane; 6],
+    corners: &'a [DVec3; 8],
+    aabb: &Aabb,
+) -> FrustumBox<'a> {
+    let scale = corners
+        .iter()
+        .map(|c| c.as_vec3())
+        .chain(aabb.corners())
+        .map(|c| c.abs().max_element())
+        .fold(0.0f32, f32::max)
+        .max(f32::MIN_POSITIVE);
+    let scale = f64::from(scale);
+    let inside_tol = 8.0 * f64::from(f32::EPSILON) * scale;
+    FrustumBox {
+        corners,
+        planes,
+        lo: aabb.min.as_dvec3(),
+        hi: aabb.max.as_dvec3(),
+        inside_tol,
+        merge_tol: 2.0 * inside_tol,
+        scale,
+    }
+}
+
 /// The planes through corner `c` of hexahedron `h` (see
 /// [`ConvexBody::two_hexahedra`]), ascending: one of each opposite pair, chosen by the
 /// bits of `c`.
@@ -397,19 +465,6 @@ fn push_plane(planes: &mut ArrayVec<DPlane, MAX_BODY_PLANES>, p: DPlane) {
     }
 }
 
-/// Intersection point of three planes, `None` when (nearly) dependent; `ca` and `ab`
-/// are the cross products `c × a` and `a × b` of their normals (shared between
-/// triples by the caller).
-fn intersect3(a: &DPlane, b: &DPlane, c: &DPlane, ca: DVec3, ab: DVec3) -> Option<DVec3> {
-    let bc = b.normal.cross(c.normal);
-    let det = a.normal.dot(bc);
-    if det.abs() < 1e-12 {
-        return None;
-    }
-    let p = (bc * -a.d + ca * -b.d + ab * -c.d) / det;
-    p.is_finite().then_some(p)
-}
-
 #[cfg(test)]
 mod tests {
     use super::ConvexBody;
@@ -422,8 +477,9 @@ mod tests {
     proptest! {
         #![proptest_config(shadowmap_testgen::proptest_config())]
 
-        /// The two-hexahedra path finds the vertices the search over every triple of
-        /// planes finds, each within the merge tolerance of one of the other's.
+        /// The frustum-box clip (edge crossings) finds the vertices the search over
+        /// every triple of planes finds, each within the merge tolerance of one of the
+        /// other's.
         #[test]
         fn hexahedra_path_matches_every_triple(case in strategy(body_case)) {
             let camera = local(&case.camera);

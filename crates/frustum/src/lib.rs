@@ -85,6 +85,7 @@ mod body;
 mod bounding_sphere;
 mod camera;
 mod cascade;
+mod clip;
 mod depth_bounds;
 mod error;
 mod frustum;
@@ -108,6 +109,7 @@ pub use camera::{Camera, Projection};
 pub use cascade::{
     Cascade, CascadeFit, CascadeOptions, CascadeSet, MAX_RESOLUTION, SceneBounds, fit_cascade,
 };
+pub use clip::MAX_FRUSTUM_AABB_VERTICES;
 pub use depth_bounds::DepthBounds;
 pub use error::FrustumError;
 pub use frustum::Frustum;

@@ -4,8 +4,8 @@
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 use shadowmap_frustum::{
-    Aabb, Camera, ConvexBody, Frustum, LightDirection, MAX_BODY_VERTICES, SceneBounds,
-    ShadowTransform, ValidCamera, math,
+    Aabb, Camera, ConvexBody, Frustum, LightDirection, MAX_BODY_VERTICES,
+    MAX_FRUSTUM_AABB_VERTICES, SceneBounds, ShadowTransform, ValidCamera, math,
 };
 
 use crate::WarpError;
@@ -202,6 +202,9 @@ pub(crate) fn check_scene(scene: &SceneBounds) -> Result<(Aabb, Aabb), WarpError
 /// Points of a convex body (fixed capacity).
 pub(crate) type Points = ArrayVec<DVec3, MAX_BODY_VERTICES>;
 
+/// Vertices of frustum ∩ receivers: a smaller capacity, so the body is cheap to move.
+pub(crate) type ReceiverPoints = ArrayVec<DVec3, MAX_FRUSTUM_AABB_VERTICES>;
+
 /// The focus body of a view and light.
 #[derive(Clone, Debug)]
 pub(crate) struct Focus {
@@ -210,7 +213,7 @@ pub(crate) struct Focus {
     pub(crate) rot: DMat4,
     pub(crate) sin_gamma: f64,
     /// Vertices of frustum ∩ receivers (world).
-    pub(crate) receivers: Points,
+    pub(crate) receivers: ReceiverPoints,
     /// The same extruded toward the light, clipped by the scene box (world); contains
     /// `receivers`.
     pub(crate) casters: Points,
@@ -234,12 +237,13 @@ impl Focus {
 pub(crate) fn focus(view: &View, light: Vec3, scene: &SceneBounds) -> Result<Focus, WarpError> {
     let dir = light_unit(light)?;
     let (receivers, casters) = check_scene(scene)?;
-    let body = ConvexBody::from_frustum_aabb(&view.frustum, &receivers)?;
+    // The vertices of the body alone: its planes are not needed here.
+    let body = ConvexBody::frustum_aabb_vertices(&view.frustum, &receivers)?;
     if body.is_empty() {
         return Err(WarpError::NoVisibleReceivers);
     }
     let (rot, sin_gamma) = frame(dir, view.forward, view.up);
-    let receivers: Points = body.vertices().iter().map(|v| v.as_dvec3()).collect();
+    let receivers: ReceiverPoints = body.iter().map(|v| v.as_dvec3()).collect();
     let casters = caster_points(&rot, &receivers, &casters);
     Ok(Focus {
         light: dir,
@@ -415,8 +419,8 @@ pub(crate) fn footprint_weight(rot: &DMat4, points: &[DVec3], scale: f64) -> f64
 /// (`ConvexBody::extruded_toward_light` of `shadowmap-frustum` is not used: its hull
 /// misses casters when the ray toward the light leaves the scene box through a side
 /// face.)
-fn caster_points(rot: &DMat4, receivers: &Points, caster_box: &Aabb) -> Points {
-    let mut out = receivers.clone();
+fn caster_points(rot: &DMat4, receivers: &[DVec3], caster_box: &Aabb) -> Points {
+    let mut out: Points = receivers.iter().copied().collect();
     let mut b = Bounds::EMPTY;
     for p in receivers {
         b.add(rot.transform_point3(*p));
