@@ -151,6 +151,7 @@ mod cascades;
 mod error;
 mod focus;
 mod lispsm;
+mod predict;
 #[cfg(feature = "serde")]
 mod serde_impls;
 mod tsm;

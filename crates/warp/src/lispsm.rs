@@ -8,6 +8,7 @@ use crate::focus::{
     Bounds, Focus, FocusBody, View, finish, footprint_weight, ortho_fit, scale_of, sqrt0,
     transform_points,
 };
+use crate::predict::{self, Probe};
 use crate::{MAX_WARP_RATIO, ParallelFade, SceneBounds};
 
 /// Options of [`lispsm`].
@@ -139,6 +140,7 @@ impl FocusBody {
     pub fn lispsm(&self, options: &LispsmOptions) -> Result<LispsmShadow, WarpError> {
         options.check()?;
         let (s, fade) = warp_strength(&self.focus, &self.view, options);
+        let s = predicted_strength(&self.focus, &self.view, s);
         let (transform, s) = warp_fit(&self.focus, &self.view, s, options.reversed_z)?;
         Ok(LispsmShadow {
             transform,
@@ -221,6 +223,17 @@ pub(crate) fn warp_fit(
     s: f64,
     reversed_z: bool,
 ) -> Result<(ShadowTransform, f64), WarpError> {
+    let (clip, s, scale) = warp_clip(f, view, s, reversed_z)?;
+    finish(f.rot, clip, reversed_z, f.light, scale).map(|t| (t, s))
+}
+
+/// The `f64` `clip_from_world` of [`warp_fit`], the `s` used and the world scale.
+pub(crate) fn warp_clip(
+    f: &Focus,
+    view: &View,
+    s: f64,
+    reversed_z: bool,
+) -> Result<(DMat4, f64, f64), WarpError> {
     let ls_casters = transform_points(&f.rot, &f.casters);
     let mut lb = Bounds::EMPTY;
     for p in &ls_casters {
@@ -257,8 +270,38 @@ pub(crate) fn warp_fit(
         return Err(WarpError::Degenerate);
     }
     let b = b.padded(scale, 1.0 - wide);
-    let clip = ortho_fit(&b, reversed_z) * warp_from_world;
-    finish(f.rot, clip, reversed_z, f.light, scale).map(|t| (t, s))
+    Ok((ortho_fit(&b, reversed_z) * warp_from_world, s, scale))
+}
+
+/// The strength to use for a warp whose formula asks for `s_formula`: the fraction
+/// of its warp ratio, `ln(1 + s d)`, of least predicted error (see
+/// [`predict::choose`]), so that the fit degrades continuously to the uniform fit
+/// where the formula's warp does not pay.
+pub(crate) fn predicted_strength(f: &Focus, view: &View, s_formula: f64) -> f64 {
+    if !(s_formula > 0.0) {
+        return 0.0;
+    }
+    let (y0, y1) = f.warp_axis_range();
+    let d = (y1 - y0).max(0.0);
+    let ln_r = ln_1p(s_formula * d);
+    if !(d > 0.0 && ln_r.is_finite() && ln_r > 0.0) {
+        return s_formula;
+    }
+    let s_at = |t: f64| {
+        if t >= 1.0 {
+            s_formula
+        } else {
+            (math::exp(t * ln_r) - 1.0) / d
+        }
+    };
+    let probe = Probe::new(view, f);
+    if probe.is_empty() {
+        return s_formula;
+    }
+    let t = predict::choose(|t| {
+        warp_clip(f, view, s_at(t), false).map_or(f64::INFINITY, |(clip, _, _)| probe.error(&clip))
+    });
+    s_at(t)
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@ use shadowmap_frustum::{Camera, MAX_BODY_VERTICES, ShadowTransform};
 
 use crate::FocusBody;
 use crate::focus::{Focus, View};
-use crate::lispsm::warp_fit;
+use crate::lispsm::{predicted_strength, warp_fit};
 use crate::{MAX_WARP_RATIO, WarpError};
 use crate::{ParallelFade, SceneBounds};
 
@@ -169,6 +169,7 @@ fn tsm_body(view: &View, f: &Focus, options: &TsmOptions) -> Result<TsmShadow, W
         s = s.min((MAX_WARP_RATIO - 1.0) / lambda);
     }
     let s = if s.is_finite() { s * fade } else { 0.0 };
+    let s = predicted_strength(f, view, s);
     let (transform, s) = warp_fit(f, view, s, options.reversed_z)?;
     Ok(TsmShadow {
         transform,
