@@ -295,10 +295,11 @@ pub(crate) fn predicted_strength(f: &Focus, view: &View, s_formula: f64) -> f64 
         }
     };
     let probe = Probe::new(view, f);
-    if probe.is_empty() {
+    let confidence = probe.confidence();
+    if !(confidence > 0.0) {
         return s_formula;
     }
-    let t = predict::choose(|t| {
+    let t = predict::choose(confidence, |t| {
         warp_clip(f, view, s_at(t), false).map_or(f64::INFINITY, |(clip, _, _)| probe.error(&clip))
     });
     s_at(t)

@@ -62,6 +62,8 @@ struct Point {
 #[derive(Clone, Debug)]
 pub(crate) struct Probe {
     points: ArrayVec<Point, { COLUMNS * ROWS * DEPTHS }>,
+    /// The weight the points would carry if every surface were front-lit.
+    geometric: f64,
 }
 
 /// The view frustum as a screen: rays by normalized position, `(0, 0)` bottom left.
@@ -105,16 +107,17 @@ impl Probe {
             b.add(*p);
         }
         let mut points = ArrayVec::new();
+        let mut geometric = 0.0;
         for row in 0..ROWS {
             for column in 0..COLUMNS {
                 let at = DVec2::new(
                     (column as f64 + 0.5) / COLUMNS as f64,
                     (row as f64 + 0.5) / ROWS as f64,
                 );
-                ray_points(&screen, &b, at, step, f.light, &mut points);
+                geometric += ray_points(&screen, &b, at, step, f.light, &mut points);
             }
         }
-        Self { points }
+        Self { points, geometric }
     }
 
     /// The predicted error `E` of the clip matrix `clip_from_world` (infinite when
@@ -144,9 +147,17 @@ impl Probe {
         }
     }
 
-    /// Whether any probe point carries weight.
-    pub(crate) fn is_empty(&self) -> bool {
-        !self.points.iter().any(|q| q.weight > 0.0)
+    /// How far the prediction is to be trusted, in `[0, 1]`: 0 when no probe point
+    /// is front-lit (or none meets the receivers), 1 from a tenth of the probe's
+    /// weight on, smooth in between, so that a fit can blend from its formula to the
+    /// predicted choice continuously as surfaces turn toward the light.
+    pub(crate) fn confidence(&self) -> f64 {
+        let lit: f64 = self.points.iter().map(|q| q.weight).sum();
+        if self.geometric > 0.0 {
+            smoothstep(0.0, 0.1, lit / self.geometric)
+        } else {
+            0.0
+        }
     }
 }
 
@@ -167,13 +178,13 @@ fn ray_points(
     step: DVec2,
     light: DVec3,
     out: &mut ArrayVec<Point, { COLUMNS * ROWS * DEPTHS }>,
-) {
+) -> f64 {
     let (o, d) = screen.ray(at);
     let (mut enter, mut exit) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
     for axis in 0..3 {
         if d[axis] == 0.0 {
             if o[axis] < b.min[axis] || o[axis] > b.max[axis] {
-                return;
+                return 0.0;
             }
             continue;
         }
@@ -189,7 +200,7 @@ fn ray_points(
     let depth = |s: f64| zn + s * (zf - zn);
     let (z0, z1) = (depth(s0), depth(s1));
     if !(s0 <= s1 && z0 > 0.0 && z1 >= z0 && zf > zn) {
-        return;
+        return 0.0;
     }
     // Rays that graze the box fade out (the clipped segment shrinks to a point) to
     // a small floor, which is every ray's weight on a flat box.
@@ -206,8 +217,10 @@ fn ray_points(
         0.0
     };
     let probe = |s: f64, n: DVec3, weight: f64| {
-        // Only front-lit surfaces are shadowed (and measured).
-        let lit = smoothstep(0.0, 0.05, -n.dot(light));
+        // Only front-lit surfaces matter: within about 3° of parallel to the light
+        // shading darkens a surface whatever the map says (and its texels stretch
+        // without bound), so such faces fade out between sin 3° and sin 6°.
+        let lit = smoothstep(0.05, 0.1, -n.dot(light));
         point_at(screen, at, step, o + d * s, n, weight * lit)
     };
     let face = |s_face: f64, slabs: &[f64; 3]| {
@@ -234,7 +247,7 @@ fn ray_points(
     }
     let w_volume = ray_weight * (1.0 - alpha) * (1.0 - beta) / DEPTHS as f64;
     if !(w_volume > 0.0) {
-        return;
+        return ray_weight;
     }
     let to_eye = -d.normalize_or_zero();
     let bisector = to_eye - light;
@@ -243,7 +256,7 @@ fn ray_points(
     // points fade out.
     let w_volume = w_volume * smoothstep(0.0, 0.1, facing);
     if !(w_volume > 0.0) {
-        return;
+        return ray_weight;
     }
     let n = bisector / facing;
     for k in 0..DEPTHS {
@@ -257,6 +270,7 @@ fn ray_points(
             w_volume,
         ));
     }
+    ray_weight
 }
 
 /// The probe point at `p` on the ray through `at`, on the plane through `p` with
@@ -326,11 +340,12 @@ const KEEP_BELOW: f64 = 0.9;
 /// error, the formula's strength is kept (`t = 1`): the paper's parameter where it
 /// clearly pays. Otherwise `t` is the minimum of the parabola through the smallest
 /// predicted error and its two neighbours on the grid, blended toward 1 as the
-/// ratio falls from 1 to [`KEEP_BELOW`]. Each step is continuous in the predicted
+/// ratio falls from 1 to [`KEEP_BELOW`], and toward 1 as the probe's
+/// `confidence` ([`Probe::confidence`]) falls to 0. Each step is continuous in the predicted
 /// errors (the parabola's minimum moves continuously as the smallest grid point
 /// changes, since the two parabolas then agree at the midpoint), so the strength is
 /// continuous in the camera and the light.
-pub(crate) fn choose(mut error: impl FnMut(f64) -> f64) -> f64 {
+pub(crate) fn choose(confidence: f64, mut error: impl FnMut(f64) -> f64) -> f64 {
     let mut e = [0.0f64; GRID];
     for (i, slot) in e.iter_mut().enumerate() {
         *slot = error(i as f64 / (GRID - 1) as f64);
@@ -345,7 +360,7 @@ pub(crate) fn choose(mut error: impl FnMut(f64) -> f64) -> f64 {
         return 1.0;
     }
     let t_opt = parabola_min(&e) / (GRID - 1) as f64;
-    let keep = 1.0 - smoothstep(KEEP_BELOW, 1.0, q);
+    let keep = 1.0 - smoothstep(KEEP_BELOW, 1.0, q) * confidence.clamp(0.0, 1.0);
     (t_opt + (1.0 - t_opt) * keep).clamp(0.0, 1.0)
 }
 

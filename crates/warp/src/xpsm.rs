@@ -300,10 +300,11 @@ fn predicted_length(view: &View, f: &Focus, options: &XpsmOptions, length: f64, 
         }
     };
     let probe = Probe::new(view, f);
-    if probe.is_empty() {
+    let confidence = probe.confidence();
+    if !(confidence > 0.0) {
         return length;
     }
-    let t = predict::choose(|t| {
+    let t = predict::choose(confidence, |t| {
         xpsm_fit(view, f, options, at(t), shift).map_or(f64::INFINITY, |fit| probe.error(&fit.clip))
     });
     at(t)
