@@ -1,4 +1,4 @@
-//! The predicted perspective-only aliasing error of a fit over the focus body, and
+//! The predicted aliasing error of a fit over the focus body, and
 //! the warp strength every warp of this crate chooses from it.
 //!
 //! A warp's strength (LiSPSM's `n`, TSM's trapezoid, XPSM's projection vector) is
@@ -13,21 +13,26 @@
 //! predicted error, which is the uniform fit where warping does not pay.
 //!
 //! The probe points: a grid of view rays through the frustum (of the camera or of
-//! one cascade slice), each clipped to the box around frustum ∩ receivers, with
-//! points at log-spaced view depths along the clipped segment. At each point the
-//! error is the perspective-only aliasing error of Lloyd, Tuft, Yoon and Manocha
-//! (*Warping and Partitioning for Low Error Shadow Maps*, EGSR 2006): the size of a
-//! texel in pixels on a surface facing the bisector of the eye and light directions,
+//! one cascade slice), each meeting the box around frustum ∩ receivers where a
+//! rendered pixel would most likely see a surface: the face it enters through (eye
+//! outside the box), else the inner face it leaves through (eye inside: floor,
+//! walls, ground), with that face's normal; where it leaves through the far plane
+//! instead, points at log-spaced depths along its segment in the box, facing the
+//! bisector of the eye and light directions. At each point the error is the
+//! aliasing error of Lloyd, Tuft, Yoon and Manocha (*Warping and Partitioning for
+//! Low Error Shadow Maps*, EGSR 2006), the size of a texel in pixels:
 //!
 //! ```text
 //! J = d(shadow-map ndc) / d(pixel)     2x2
 //! m = 1 / s_min(J)                     (in units common to every candidate)
-//! E = (Σ w_i m_i^P / Σ w_i)^(1/P)      P = 8, weights fading rays that graze the box
+//! E = (Σ w_i m_i^P / Σ w_i)^(1/P)      P = 8; weights fade rays that graze the box
+//!                                      and faces within about 3° of the light
 //! ```
 //!
 //! Every ingredient is a continuous function of the camera and the light (weights
-//! fade rays in and out, no point is switched on or off), and so is the chosen
-//! strength (below): the fits never pop.
+//! fade points in and out; only a ray that stops meeting the box altogether drops
+//! out, by then at a small floor weight), and so is the chosen strength (below):
+//! the fits do not pop.
 
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec3};
