@@ -277,7 +277,10 @@ pub(crate) fn focus(view: &View, light: Vec3, scene: &SceneBounds) -> Result<Foc
 ///     Vec3::Y,
 ///     Projection::perspective(1.0, 1.5, 0.5, 100.0),
 /// )?;
-/// let scene = SceneBounds::whole(Aabb::new(Vec3::splat(-50.0), Vec3::splat(50.0)));
+/// // A ground slab with casters up to 10 m.
+/// let ground = Aabb::new(Vec3::new(-50.0, -1.0, -100.0), Vec3::new(50.0, 0.0, 10.0));
+/// let casters = Aabb::new(Vec3::new(-50.0, -1.0, -100.0), Vec3::new(50.0, 10.0, 10.0));
+/// let scene = SceneBounds::new(ground, casters);
 /// let body = FocusBody::new(&camera, Vec3::new(0.3, -1.0, -0.2), &scene)?;
 /// let l = body.lispsm(&LispsmOptions::default())?;
 /// let t = body.tsm(&TsmOptions::default())?;

@@ -104,6 +104,13 @@
 //!   Not covered: a light grazing the ground (within 2°), where TSM's texel sizes
 //!   change by more than 2% per 0.01° (continuously), and a light from below the
 //!   ground, where LiSPSM and XPSM can exceed the uniform fit's largest error;
+//! - a warp that would not pay (its formula's strength predicted worse than, or
+//!   about as good as, the uniform fit over the focus body: a camera inside a
+//!   large scene, looking down, a wall the light grazes): LiSPSM, TSM and XPSM
+//!   (automatic length) scale their warp ratio to the fraction of least predicted
+//!   perspective aliasing error (Lloyd et al.), continuously down to the uniform
+//!   fit, so that no warp is predicted worse than the uniform fit anywhere (see
+//!   [`lispsm`]);
 //! - focus region thinner across the light than `f32` resolves at
 //!   [`MAX_MAP_SIDE`] texels (a point receiver, a tiny scene far from the origin, a
 //!   flat box seen edge-on): the uniform fit widened to [`MIN_RELATIVE_EXTENT`] times
@@ -151,6 +158,7 @@ mod cascades;
 mod error;
 mod focus;
 mod lispsm;
+mod predict;
 #[cfg(feature = "serde")]
 mod serde_impls;
 mod tsm;

@@ -1,0 +1,393 @@
+//! The predicted aliasing error of a fit over the focus body, and
+//! the warp strength every warp of this crate chooses from it.
+//!
+//! A warp's strength (LiSPSM's `n`, TSM's trapezoid, XPSM's projection vector) is
+//! set by a formula that assumes a particular layout: the visible region starts at
+//! the viewer and runs along the view direction, made perpendicular to the light
+//! (Wimmer et al.'s `n_opt`, Martin and Tan's 80% rule, Gusev's `coef / cos γ`).
+//! Where the layout differs (a camera looking down, a light near the view axis, a
+//! focus body much larger than what is seen, a projection vector clipped at the
+//! back-projection singularity) the formula over-warps, and the warp can lose badly
+//! to the uniform fit. So each warp evaluates its own fit at a few strengths on a
+//! fixed set of probe points of the focus body and takes the strength of least
+//! predicted error, which is the uniform fit where warping does not pay.
+//!
+//! The probe points: a grid of view rays through the frustum (of the camera or of
+//! one cascade slice), each meeting the box around frustum ∩ receivers where a
+//! rendered pixel would most likely see a surface: the face it enters through (eye
+//! outside the box), else the inner face it leaves through (eye inside: floor,
+//! walls, ground), with that face's normal; where it leaves through the far plane
+//! instead, points at log-spaced depths along its segment in the box, facing the
+//! bisector of the eye and light directions. At each point the error is the
+//! aliasing error of Lloyd, Tuft, Yoon and Manocha (*Warping and Partitioning for
+//! Low Error Shadow Maps*, EGSR 2006), the size of a texel in pixels:
+//!
+//! ```text
+//! J = d(shadow-map ndc) / d(pixel)     2x2
+//! m = 1 / s_min(J)                     (in units common to every candidate)
+//! E = (Σ w_i m_i^P / Σ w_i)^(1/P)      P = 8; weights fade rays that graze the box
+//!                                      and faces within about 3° of the light
+//! ```
+//!
+//! Every ingredient is a continuous function of the camera and the light (weights
+//! fade points in and out; only a ray that stops meeting the box altogether drops
+//! out, by then at a small floor weight), and so is the chosen strength (below):
+//! the fits do not pop.
+
+use arrayvec::ArrayVec;
+use glam::{DMat4, DVec2, DVec3};
+use shadowmap_frustum::math;
+
+use crate::focus::{Bounds, Focus, View, smoothstep};
+
+/// Rays across and down the view.
+const COLUMNS: usize = 8;
+const ROWS: usize = 6;
+/// Probe points per ray.
+const DEPTHS: usize = 4;
+/// Exponent of the power mean over the probe points (between a mean and a maximum,
+/// close to the high percentiles by which the quality report ranks techniques).
+const POWER: f64 = 8.0;
+/// Smallest weight of a ray that meets the box.
+const RAY_WEIGHT_FLOOR: f64 = 1e-3;
+/// Relative screen step of the pixel Jacobian.
+const STEP: f64 = 1e-3;
+
+/// One probe point: the world point, the world displacements of one screen step in
+/// x and y on the plane through it facing the bisector, and its weight.
+#[derive(Clone, Copy, Debug)]
+struct Point {
+    p: DVec3,
+    dx: DVec3,
+    dy: DVec3,
+    weight: f64,
+}
+
+/// The probe points of a focus body.
+#[derive(Clone, Debug)]
+pub(crate) struct Probe {
+    points: ArrayVec<Point, { COLUMNS * ROWS * DEPTHS }>,
+    /// The weight the points would carry if every surface were front-lit.
+    geometric: f64,
+}
+
+/// The view frustum as a screen: rays by normalized position, `(0, 0)` bottom left.
+struct Screen {
+    near: [DVec3; 4],
+    far: [DVec3; 4],
+    forward: DVec3,
+    eye: DVec3,
+}
+
+impl Screen {
+    fn ray(&self, at: DVec2) -> (DVec3, DVec3) {
+        let bilerp = |q: &[DVec3; 4]| {
+            let bottom = q[0].lerp(q[1], at.x);
+            let top = q[3].lerp(q[2], at.x);
+            bottom.lerp(top, at.y)
+        };
+        let origin = bilerp(&self.near);
+        (origin, bilerp(&self.far) - origin)
+    }
+
+    fn depth(&self, p: DVec3) -> f64 {
+        (p - self.eye).dot(self.forward)
+    }
+}
+
+impl Probe {
+    /// The probe points of `f` seen from `view`.
+    pub(crate) fn new(view: &View, f: &Focus) -> Self {
+        let c = view.frustum.corners.map(glam::Vec3::as_dvec3);
+        let screen = Screen {
+            near: [c[0], c[1], c[2], c[3]],
+            far: [c[4], c[5], c[6], c[7]],
+            forward: view.forward,
+            eye: view.eye,
+        };
+        let aspect = (c[1] - c[0]).length() / (c[3] - c[0]).length();
+        let step = DVec2::new(STEP / aspect.max(1e-12), STEP);
+        let mut b = Bounds::EMPTY;
+        for p in &f.receivers {
+            b.add(*p);
+        }
+        let mut points = ArrayVec::new();
+        let mut geometric = 0.0;
+        for row in 0..ROWS {
+            for column in 0..COLUMNS {
+                let at = DVec2::new(
+                    (column as f64 + 0.5) / COLUMNS as f64,
+                    (row as f64 + 0.5) / ROWS as f64,
+                );
+                geometric += ray_points(&screen, &b, at, step, f.light, &mut points);
+            }
+        }
+        Self { points, geometric }
+    }
+
+    /// The predicted error `E` of the clip matrix `clip_from_world` (infinite when
+    /// a probe point falls behind its projection centre).
+    pub(crate) fn error(&self, clip_from_world: &DMat4) -> f64 {
+        let (mut sum, mut weights) = (0.0, 0.0);
+        for q in &self.points {
+            let h = *clip_from_world * q.p.extend(1.0);
+            if !(h.w > 0.0) {
+                return f64::INFINITY;
+            }
+            let ndc = |d: DVec3| {
+                let dh = *clip_from_world * d.extend(0.0);
+                (DVec2::new(dh.x, dh.y) * h.w - DVec2::new(h.x, h.y) * dh.w) / (h.w * h.w)
+            };
+            let s = smaller_singular_value(ndc(q.dx), ndc(q.dy));
+            if !(s > 0.0) {
+                return f64::INFINITY;
+            }
+            sum += q.weight * pow8(1.0 / s);
+            weights += q.weight;
+        }
+        if weights > 0.0 {
+            math::powf(sum / weights, 1.0 / POWER)
+        } else {
+            0.0
+        }
+    }
+
+    /// How far the prediction is to be trusted, in `[0, 1]`: 0 when no probe point
+    /// is front-lit (or none meets the receivers), 1 from a tenth of the probe's
+    /// weight on, smooth in between, so that a fit can blend from its formula to the
+    /// predicted choice continuously as surfaces turn toward the light.
+    pub(crate) fn confidence(&self) -> f64 {
+        let lit: f64 = self.points.iter().map(|q| q.weight).sum();
+        if self.geometric > 0.0 {
+            smoothstep(0.0, 0.1, lit / self.geometric)
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The probe points of the ray through `at` (see [`Probe::new`]).
+///
+/// Where the surface a pixel sees lies is unknown; the receivers' box stands in for
+/// it: the face the ray enters through (eye outside the box), else the inner face
+/// it leaves through (eye inside: the floor, walls and ground of a scene seen from
+/// within), each with that face's normal; where the ray leaves through the far plane
+/// instead, `DEPTHS` points at log-spaced depths along its segment inside the box,
+/// facing the bisector of the eye and light directions. Between these cases the
+/// weights blend over a 5% band of depth, and a face's normal over a 2% band near
+/// the box's edges, so every weight and normal is continuous.
+fn ray_points(
+    screen: &Screen,
+    b: &Bounds,
+    at: DVec2,
+    step: DVec2,
+    light: DVec3,
+    out: &mut ArrayVec<Point, { COLUMNS * ROWS * DEPTHS }>,
+) -> f64 {
+    let (o, d) = screen.ray(at);
+    let (mut enter, mut exit) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
+    for axis in 0..3 {
+        if d[axis] == 0.0 {
+            if o[axis] < b.min[axis] || o[axis] > b.max[axis] {
+                return 0.0;
+            }
+            continue;
+        }
+        let t0 = (b.min[axis] - o[axis]) / d[axis];
+        let t1 = (b.max[axis] - o[axis]) / d[axis];
+        enter[axis] = t0.min(t1);
+        exit[axis] = t0.max(t1);
+    }
+    let s_enter = enter[0].max(enter[1]).max(enter[2]);
+    let s_exit = exit[0].min(exit[1]).min(exit[2]);
+    let (s0, s1) = (s_enter.max(0.0), s_exit.min(1.0));
+    let (zn, zf) = (screen.depth(o), screen.depth(o + d));
+    let depth = |s: f64| zn + s * (zf - zn);
+    let (z0, z1) = (depth(s0), depth(s1));
+    if !(s0 <= s1 && z0 > 0.0 && z1 >= z0 && zf > zn) {
+        return 0.0;
+    }
+    // Rays that graze the box fade out (the clipped segment shrinks to a point) to
+    // a small floor, which is every ray's weight on a flat box.
+    let ln_ratio = math::ln(z1 / z0);
+    let ray_weight = smoothstep(0.0, 0.05, ln_ratio).max(RAY_WEIGHT_FLOOR);
+    let alpha = if s_enter > 0.0 {
+        smoothstep(0.0, 0.05, math::ln(z0 / zn))
+    } else {
+        0.0
+    };
+    let beta = if s_exit < 1.0 {
+        smoothstep(0.0, 0.05, math::ln(zf / z1))
+    } else {
+        0.0
+    };
+    let probe = |s: f64, n: DVec3, weight: f64| {
+        // Only front-lit surfaces matter: within about 3° of parallel to the light
+        // shading darkens a surface whatever the map says (and its texels stretch
+        // without bound), so such faces fade out between sin 3° and sin 6°.
+        let lit = smoothstep(0.05, 0.1, -n.dot(light));
+        point_at(screen, at, step, o + d * s, n, weight * lit)
+    };
+    let face = |s_face: f64, slabs: &[f64; 3]| {
+        let mut n = DVec3::ZERO;
+        for axis in 0..3 {
+            let rel = (s_face - slabs[axis]).abs() * (zf - zn) / depth(s_face);
+            let mut e = DVec3::ZERO;
+            e[axis] = -d[axis].signum();
+            n += e * (1.0 - smoothstep(0.0, 0.02, rel));
+        }
+        n.normalize_or_zero()
+    };
+    let mut push = |q: Option<Point>| {
+        if let Some(q) = q.filter(|q| q.weight > 0.0) {
+            let _ = out.try_push(q);
+        }
+    };
+    if alpha > 0.0 {
+        push(probe(s0, face(s0, &enter), ray_weight * alpha));
+    }
+    let w_exit = ray_weight * (1.0 - alpha) * beta;
+    if w_exit > 0.0 {
+        push(probe(s1, face(s1, &exit), w_exit));
+    }
+    let w_volume = ray_weight * (1.0 - alpha) * (1.0 - beta) / DEPTHS as f64;
+    if !(w_volume > 0.0) {
+        return ray_weight;
+    }
+    let to_eye = -d.normalize_or_zero();
+    let bisector = to_eye - light;
+    let facing = bisector.length();
+    // Where the light comes straight at the viewer the bisector vanishes: the
+    // points fade out.
+    let w_volume = w_volume * smoothstep(0.0, 0.1, facing);
+    if !(w_volume > 0.0) {
+        return ray_weight;
+    }
+    let n = bisector / facing;
+    for k in 0..DEPTHS {
+        let z = z0 * math::exp(ln_ratio * (k as f64 + 0.5) / DEPTHS as f64);
+        push(point_at(
+            screen,
+            at,
+            step,
+            o + d * ((z - zn) / (zf - zn)),
+            n,
+            w_volume,
+        ));
+    }
+    ray_weight
+}
+
+/// The probe point at `p` on the ray through `at`, on the plane through `p` with
+/// normal `n`.
+fn point_at(
+    screen: &Screen,
+    at: DVec2,
+    step: DVec2,
+    p: DVec3,
+    n: DVec3,
+    weight: f64,
+) -> Option<Point> {
+    let on_plane = |offset: DVec2| -> Option<DVec3> {
+        let (ro, rd) = screen.ray(at + offset);
+        let denom = n.dot(rd);
+        (denom.abs() > 1e-12 * rd.length()).then(|| ro + rd * (n.dot(p - ro) / denom))
+    };
+    let (xp, xm) = (
+        on_plane(DVec2::new(step.x, 0.0))?,
+        on_plane(DVec2::new(-step.x, 0.0))?,
+    );
+    let (yp, ym) = (
+        on_plane(DVec2::new(0.0, step.y))?,
+        on_plane(DVec2::new(0.0, -step.y))?,
+    );
+    let q = Point {
+        p,
+        dx: (xp - xm) * 0.5,
+        dy: (yp - ym) * 0.5,
+        weight,
+    };
+    (weight > 0.0 && p.is_finite() && q.dx.is_finite() && q.dy.is_finite()).then_some(q)
+}
+
+/// `x^8`.
+fn pow8(x: f64) -> f64 {
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    x4 * x4
+}
+
+/// The smaller singular value of the 2x2 matrix with columns `a`, `b`.
+fn smaller_singular_value(a: DVec2, b: DVec2) -> f64 {
+    let frobenius = a.length_squared() + b.length_squared();
+    let det = a.perp_dot(b);
+    let root = math::sqrt((frobenius * frobenius - 4.0 * det * det).max(0.0));
+    let denom = frobenius + root;
+    if denom > 0.0 {
+        math::sqrt(2.0 * det * det / denom)
+    } else {
+        0.0
+    }
+}
+
+/// Strengths at which a warp is evaluated, as fractions of its formula's warp in
+/// `ln(1 + s d)` (0: the uniform fit, 1: the formula's).
+const GRID: usize = 5;
+
+/// Predicted error of full warp over the uniform fit's below which the formula's
+/// strength is kept as it is.
+const KEEP_BELOW: f64 = 0.9;
+
+/// The fraction `t` in `[0, 1]` of a warp's formula strength to use, from the
+/// predicted errors `error(t)` at `t = 0, 1/4, ..., 1`.
+///
+/// Where the full warp is predicted at most [`KEEP_BELOW`] times the uniform fit's
+/// error, the formula's strength is kept (`t = 1`): the paper's parameter where it
+/// clearly pays. Otherwise `t` is the minimum of the parabola through the smallest
+/// predicted error and its two neighbours on the grid, blended toward 1 as the
+/// ratio falls from 1 to [`KEEP_BELOW`], and toward 1 as the probe's
+/// `confidence` ([`Probe::confidence`]) falls to 0. Each step is continuous in the predicted
+/// errors (the parabola's minimum moves continuously as the smallest grid point
+/// changes, since the two parabolas then agree at the midpoint), so the strength is
+/// continuous in the camera and the light.
+pub(crate) fn choose(confidence: f64, mut error: impl FnMut(f64) -> f64) -> f64 {
+    let mut e = [0.0f64; GRID];
+    for (i, slot) in e.iter_mut().enumerate() {
+        *slot = error(i as f64 / (GRID - 1) as f64);
+    }
+    let q = e[GRID - 1] / e[0];
+    if !(e[0].is_finite() && e[0] > 0.0) {
+        // No usable prediction for the uniform fit: keep the formula (it is then the
+        // only information there is), unless the warp is unusable too.
+        return if e[GRID - 1].is_finite() { 1.0 } else { 0.0 };
+    }
+    if q <= KEEP_BELOW {
+        return 1.0;
+    }
+    let t_opt = parabola_min(&e) / (GRID - 1) as f64;
+    let keep = 1.0 - smoothstep(KEEP_BELOW, 1.0, q) * confidence.clamp(0.0, 1.0);
+    (t_opt + (1.0 - t_opt) * keep).clamp(0.0, 1.0)
+}
+
+/// The grid position (in `[0, GRID - 1]`) of the minimum of the parabola through
+/// the smallest entry of `e` and its neighbours (the end triple at the ends).
+fn parabola_min(e: &[f64; GRID]) -> f64 {
+    let mut best = 0;
+    for i in 1..GRID {
+        if e[i] < e[best] {
+            best = i;
+        }
+    }
+    if !e[best].is_finite() {
+        return 0.0;
+    }
+    let j = best.clamp(1, GRID - 2);
+    let (a, b, c) = (e[j - 1], e[j], e[j + 1]);
+    let curvature = a - 2.0 * b + c;
+    let x = if curvature > 0.0 && a.is_finite() && c.is_finite() {
+        j as f64 + 0.5 * (a - c) / curvature
+    } else {
+        best as f64
+    };
+    x.clamp((j - 1) as f64, (j + 1) as f64)
+}
