@@ -4,8 +4,8 @@
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec3, Mat4, Vec2, Vec3};
 use shadowmap_frustum::{
-    Aabb, Camera, ConvexBody, DepthBounds, FrustumError, Light, SceneBounds, ShadowMapping,
-    ShadowSample, projection,
+    Aabb, Camera, ConvexBody, DepthBounds, FrustumError, Light, LightDirection, SceneBounds,
+    ShadowMapping, ShadowSample, ShadowTransform, projection,
 };
 
 use crate::ParaboloidError;
@@ -358,6 +358,22 @@ impl CubeMap {
     #[must_use]
     pub fn layers(&self) -> u32 {
         self.faces.len() as u32
+    }
+
+    /// The matrices of the face in `layer` for a matrix depth pass and lookup
+    /// (`light_from_world` is the face's view, looking down its `-Z`); `None` past the
+    /// last layer.
+    #[must_use]
+    pub fn transform(&self, layer: u32) -> Option<ShadowTransform> {
+        let f = self.faces.get(layer as usize)?;
+        let view = CubeFace::view_from_world(f.face, self.position.as_dvec3()).as_mat4();
+        let light = LightDirection::Position(self.position);
+        Some(ShadowTransform::new(
+            view,
+            f.clip_from_world,
+            self.reversed_z,
+            light,
+        ))
     }
 
     /// The layer of a face, `None` when the face was skipped.
