@@ -9,7 +9,7 @@ use shadowmap_frustum::{
 };
 
 use crate::ParaboloidError;
-use crate::cube_fit::{FaceExtent, effective_near, face_extent, min_depth_of_box};
+use crate::cube_fit::{FaceExtent, effective_near, face_extent};
 use crate::map::check_depth_range;
 
 /// One face of a cube map: the direction it looks along, world axis aligned.
@@ -339,7 +339,7 @@ impl CubeMap {
                 options.focused,
                 near,
                 f64::from(range),
-                casters.map(|c| min_depth_of_box(&c, light_at, face)),
+                casters.as_ref().map(|c| (c, light_at, face)),
                 MIN_TAN_EXTENT,
             );
             faces.push(CubeFace::new(face, light_at, &extent, options.reversed_z)?);

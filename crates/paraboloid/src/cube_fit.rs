@@ -19,7 +19,7 @@
 
 use arrayvec::ArrayVec;
 use glam::{DVec2, DVec3};
-use shadowmap_frustum::{Aabb, MAX_BODY_VERTICES};
+use shadowmap_frustum::{Aabb, ConvexBody, Frustum, MAX_BODY_VERTICES};
 
 use crate::cube::CubeFaceId;
 
@@ -69,16 +69,23 @@ impl FaceExtent {
     /// `near` is the smallest near plane ([`effective_near`]).
     /// Unfocused: the whole face over `[near, range]`. Focused: the window
     /// widened by [`WINDOW_MARGIN`] and to at least `min_extent` per axis (about its
-    /// centre, kept inside the face), near at the casters' smallest face depth
-    /// (`casters_min`, the casters ∩ range box) but no farther than the receivers and
-    /// no closer than `near`, far at the receivers' largest depth (at most
-    /// `range`), and at least `1.001 near` so that `f32` depth resolves the range.
+    /// centre, kept inside the face), far at the receivers' largest depth (at most
+    /// `range`), near at the smallest face depth of the casters (the casters ∩ range
+    /// box, given as `casters`) inside the window's frustum up to that far plane,
+    /// but no farther than the receivers and no closer than `near`; far at least
+    /// `1.001 near` so that `f32` depth resolves the range.
+    ///
+    /// Taking the casters inside the window, not the whole caster box, keeps the near
+    /// plane off the light when the box holds it (a lamp among buildings): the
+    /// perspective depth `far (d - near) / ((far - near) d)` spends its precision
+    /// near `near`, so a tiny near plane leaves a depth bias of a few `1e-5` metres'
+    /// worth at the receivers.
     pub(crate) fn choose_depth(
         &mut self,
         focused: bool,
         near: f64,
         range: f64,
-        casters_min: Option<f64>,
+        casters: Option<(&Aabb, DVec3, CubeFaceId)>,
         min_extent: f64,
     ) {
         if !focused {
@@ -97,11 +104,58 @@ impl FaceExtent {
         self.tan_min = (centre - half).max(DVec2::splat(-edge));
         self.tan_max = (centre + half).min(DVec2::splat(edge));
         let receivers_near = self.receivers_min.max(near);
+        let far = self.receivers_max.min(range).max(receivers_near * 1.001);
+        let casters_min = casters.and_then(|(b, light, face)| {
+            casters_min_depth(b, light, face, (self.tan_min, self.tan_max), near, far)
+        });
         self.near = casters_min
             .map_or(receivers_near, |c| c.min(receivers_near))
             .max(near);
-        self.far = self.receivers_max.min(range).max(self.near * 1.001);
+        self.far = far.max(self.near * 1.001);
     }
+}
+
+/// The smallest face depth of `casters` inside the window frustum `window` over
+/// `[near, far]`; `None` when no caster is inside it; the whole box's smallest
+/// depth when the frustum is too thin for the clipping.
+fn casters_min_depth(
+    casters: &Aabb,
+    light: DVec3,
+    face: CubeFaceId,
+    window: (DVec2, DVec2),
+    near: f64,
+    far: f64,
+) -> Option<f64> {
+    let (lo, hi) = window;
+    let (f, u) = (face.forward().as_dvec3(), face.up().as_dvec3());
+    let r = f.cross(u);
+    let corner = |d: f64, x: f64, y: f64| (light + (r * x + u * y + f) * d).as_vec3();
+    let at = |d: f64| {
+        [
+            corner(d, lo.x, lo.y),
+            corner(d, hi.x, lo.y),
+            corner(d, hi.x, hi.y),
+            corner(d, lo.x, hi.y),
+        ]
+    };
+    let (n, fa) = (at(near), at(far));
+    let corners = [n[0], n[1], n[2], n[3], fa[0], fa[1], fa[2], fa[3]];
+    let body =
+        Frustum::from_corners(corners).and_then(|fr| ConvexBody::from_frustum_aabb(&fr, casters));
+    let Ok(body) = body else {
+        return Some(min_depth_of_box(casters, light, face));
+    };
+    // The vertices are `f32`: allow their rounding.
+    let scale = body
+        .vertices()
+        .iter()
+        .map(|v| f64::from(v.abs().max_element()))
+        .fold(0.0, f64::max);
+    body.vertices()
+        .iter()
+        .map(|v| face.coords(v.as_dvec3() - light).z)
+        .reduce(f64::min)
+        .map(|d| d - 8.0 * f64::from(f32::EPSILON) * scale)
 }
 
 /// The window of `face` on a convex body given by its vertices relative to the

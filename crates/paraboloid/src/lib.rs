@@ -210,7 +210,7 @@
 //! ```text
 //! window(face) = bounding rectangle of proj(V ∩ {d >= near}) ∩ [-1, 1]²
 //! proj(a, b, d) = (a / d, b / d)      (face coordinates: right, up, forward)
-//! near(face)    = clamp(min d over casters ∩ range box, near option, min d over V)
+//! near(face)    = clamp(min d over casters ∩ range box ∩ window frustum, near option, min d over V)
 //! far(face)     = min(max d over V, range)
 //! ```
 //!
