@@ -255,6 +255,23 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
+//! Measured with the `compare` report of `shadowmap-eval` (seed 1, 1M texels, p95
+//! aliasing error `m`; the same figures within 4% on seeds 2 and 3):
+//!
+//! | configuration | DPSM | IPSM exact | cube, focused | cube, full faces |
+//! |---|---|---|---|---|
+//! | `point_near` | 4.73 | 2.62 | 2.46 (5 faces) | 2.46 |
+//! | `point_mid` | 28.9 | 13.2 | 13.3 (5 faces) | 18.6 |
+//! | `point_far` | 115 | 55.7 | 54.5 (5 faces) | 97.2 |
+//! | `point_inside` | 5.02 | 4.56 | 5.42 (6 faces) | 5.42 |
+//! | `facing_point` | 18.4 | 15.5 | 23.7 (6 faces) | 23.7 |
+//!
+//! With the light among the visible receivers every face is kept at full size, and
+//! six maps of `1024² / 6` texels lose to a DPSM's two of `1024² / 2` (1.08 and 1.29
+//! times its `m`); once faces can be skipped and focused, the cube halves the DPSM's
+//! error. The fit costs about 0.1 ms (`cargo bench --bench paraboloid -- cube_fit`:
+//! focused about 8 times an exact IPSM plan on the shared development machine).
+//!
 //! Errors ([`ParaboloidError`]): as the other builders for non-finite input, a bad
 //! near option or depth range, and a directional light;
 //! `ParaboloidError::Frustum(FrustumError::SliceOutsideScene)` when no visible
