@@ -1,11 +1,15 @@
 //! Per-frame cost of one IPSM plan with the exact minimal cone versus the paper's
 //! averaged cone (same configurations, same run, camera validation alone as the
-//! floor), and of the two cone fits alone.
+//! floor), and of the two cone fits alone; the per-frame fit of the cube maps
+//! (focused and full faces) against building a DPSM, in the same run.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
-use shadowmap::frustum::{Camera, DepthBounds, Light, Projection};
-use shadowmap::paraboloid::{ConeFit, IpsmOptions, IpsmPlan, fit_minimal_cone, fit_paper_cone};
+use shadowmap::frustum::{Aabb, Camera, DepthBounds, Light, Projection, SceneBounds};
+use shadowmap::paraboloid::{
+    ConeFit, CubeMap, CubeOptions, IpsmOptions, IpsmPlan, MapOptions, ParaboloidMap,
+    fit_minimal_cone, fit_paper_cone,
+};
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -81,5 +85,47 @@ fn plan(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, plan);
+/// One cube-map fit per iteration over the same 64 configurations, above a ground
+/// slab with casters: focused and unfocused, and `ParaboloidMap::dual` (a DPSM's
+/// whole per-frame build) in the same group as the reference for the ratio.
+fn cube(c: &mut Criterion) {
+    let cases = configs();
+    let ground = Aabb::new(
+        Vec3::new(-300.0, -1.0, -300.0),
+        Vec3::new(300.0, 0.0, 300.0),
+    );
+    let scene = SceneBounds::new(
+        ground,
+        ground.union(&Aabb::new(ground.min, Vec3::new(300.0, 30.0, 300.0))),
+    );
+    let mut g = c.benchmark_group("cube_fit");
+    g.warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(2));
+    let mut i = 0usize;
+    g.bench_function("dpsm_map", |b| {
+        b.iter(|| {
+            i = (i + 1) % cases.len();
+            let Light::Point { position, range } = cases[i].0 else {
+                unreachable!()
+            };
+            black_box(
+                ParaboloidMap::dual(position, Vec3::NEG_Y, 0.05, range, &MapOptions::default())
+                    .unwrap(),
+            )
+        });
+    });
+    for (name, focused) in [("focused", true), ("unfocused", false)] {
+        let options = CubeOptions::default().with_focused(focused);
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                i = (i + 1) % cases.len();
+                let (light, camera, bounds) = &cases[i];
+                black_box(CubeMap::fit(light, camera, Some(*bounds), &scene, &options).unwrap())
+            });
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, plan, cube);
 criterion_main!(benches);

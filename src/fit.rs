@@ -9,7 +9,7 @@ use shadowmap_frustum::{
     Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, FrustumError,
     Light, MAX_CASCADES, SceneBounds, SplitScheme, TechniqueSelector, fit_spot,
 };
-use shadowmap_paraboloid::{IpsmPlan, ParaboloidError, ParaboloidMap};
+use shadowmap_paraboloid::{CubeMap, IpsmPlan, ParaboloidError, ParaboloidMap};
 use shadowmap_rtw::{EyeSample, ImportanceMap, OracleAxis, RtwError, WarpMaps};
 use shadowmap_warp::{
     LispsmOptions, WarpError, lispsm, tsm, uniform_focused, warped_cascades, xpsm,
@@ -24,7 +24,7 @@ use crate::technique::{CascadePlan, DpsmOptions, RtwPlan, Technique};
 /// techniques that need them (see the crate docs' table):
 /// [`eye_samples`](Self::eye_samples) (RTW and the RTW oracle, required there),
 /// [`pixels_per_radian`](Self::pixels_per_radian) (RTW oracle, required there),
-/// [`depth_bounds`](Self::depth_bounds) (cascades, warped cascades, auto, IPSM; the
+/// [`depth_bounds`](Self::depth_bounds) (cascades, warped cascades, auto, IPSM, cube maps; the
 /// camera's depth range without them).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
@@ -124,7 +124,7 @@ pub enum FitError {
     Frustum(FrustumError),
     /// From `shadowmap-warp` (uniform, LiSPSM, XPSM, TSM, warped cascades).
     Warp(WarpError),
-    /// From `shadowmap-paraboloid` (DPSM, IPSM).
+    /// From `shadowmap-paraboloid` (DPSM, IPSM, cube maps).
     Paraboloid(ParaboloidError),
     /// From `shadowmap-rtw` (importance, warp tables).
     Rtw(RtwError),
@@ -254,6 +254,11 @@ fn fit_one(technique: &Technique, input: &FitInput<'_>) -> Result<(Fitted, u32),
             let plan = IpsmPlan::new(input.light, camera, input.depth_bounds, o)?;
             let layers = plan.map.layers();
             (Fitted::Ipsm(plan), layers)
+        }
+        Technique::CubeMaps(o) => {
+            let cube = CubeMap::fit(input.light, camera, input.depth_bounds, scene, o)?;
+            let layers = cube.layers();
+            (Fitted::Cube(cube), layers)
         }
         // `fit_with_selector` handles `auto` before coming here.
         Technique::Auto(_) => return Err(FitError::NoCandidate),

@@ -79,6 +79,7 @@
 //! | `SpotFit` | spot | 1 | | perspective fit to frustum ∩ receivers |
 //! | `Dpsm` | point | 2 | | Brabec, Annen and Seidel, *Shadow mapping for hemispherical and omnidirectional light sources* |
 //! | `Ipsm` | point | 1 or 2 | D | Vanek, Navrátil, Herout and Zemčík, *High-quality shadows with improved paraboloid mapping*; `ConeFit::Exact` uses the exact minimal enclosing cone |
+//! | `CubeMaps` | point | 1..=6 | D | cube shadow maps, the engines' point-light baseline: the faces that see visible receivers, each focused on them (`CubeOptions::focused`) |
 //!
 //! Cascade count: with depth bounds of ratio `r = max / min` and `k` maps sharing the
 //! budget, each cascade of a logarithmic split covers a ratio `r^(1/k)` on `side(k)`

@@ -2,7 +2,7 @@
 
 use glam::{DVec3, Vec3};
 use shadowmap_frustum::{CascadeSet, ShadowMapping, ShadowSample, ShadowTransform, SpotShadow};
-use shadowmap_paraboloid::{IpsmPlan, ParaboloidMap};
+use shadowmap_paraboloid::{CubeMap, IpsmPlan, ParaboloidMap};
 use shadowmap_rtw::{RtwShadow, WarpMaps};
 use shadowmap_warp::{LispsmShadow, TsmShadow, WarpedCascades, WarpedCascadesView, XpsmShadow};
 
@@ -52,6 +52,8 @@ pub enum Fitted {
     Dpsm(ParaboloidMap),
     /// The IPSM plan (its map is single or dual).
     Ipsm(IpsmPlan),
+    /// Cube shadow maps, one layer per kept face.
+    Cube(CubeMap),
 }
 
 /// A technique fitted to one frame by [`fit`](crate::fit): what was asked for, what
@@ -91,7 +93,7 @@ impl Shadow {
         &self.fitted
     }
 
-    /// Number of layers: cascades, paraboloid sides, 1 for a single map.
+    /// Number of layers: cascades, paraboloid sides, cube faces, 1 for a single map.
     #[must_use]
     pub const fn layers(&self) -> u32 {
         self.layers
@@ -133,6 +135,15 @@ impl Shadow {
         }
     }
 
+    /// The cube map of [`Technique::CubeMaps`].
+    #[must_use]
+    pub const fn cube(&self) -> Option<&CubeMap> {
+        match &self.fitted {
+            Fitted::Cube(cube) => Some(cube),
+            _ => None,
+        }
+    }
+
     /// RTW's base fit and tables, borrowed as the rtw crate's [`RtwShadow`].
     #[must_use]
     pub const fn rtw(&self) -> Option<RtwShadow<'_>> {
@@ -165,6 +176,7 @@ impl Fitted {
             Self::WarpedCascades { cascades, .. } => cascades.cascades.len(),
             Self::Dpsm(map) => map.layers() as usize,
             Self::Ipsm(plan) => plan.map.layers() as usize,
+            Self::Cube(cube) => cube.faces.len(),
             _ => 1,
         };
         u32::try_from(count).unwrap_or(u32::MAX)
@@ -221,6 +233,7 @@ impl ShadowMapping for Shadow {
             Fitted::Rtw { base, warps } => RtwShadow { base: *base, warps }.map_point(world),
             Fitted::Dpsm(map) => map.map_point(world),
             Fitted::Ipsm(plan) => plan.map.map_point(world),
+            Fitted::Cube(cube) => cube.map_point(world),
             Fitted::Uniform(t) => t.map_point(world),
             Fitted::Lispsm(LispsmShadow { transform, .. })
             | Fitted::Xpsm(XpsmShadow { transform, .. })

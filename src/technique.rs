@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 use shadowmap_frustum::Light;
-use shadowmap_paraboloid::{ConeFit, IpsmOptions, MapOptions};
+use shadowmap_paraboloid::{ConeFit, CubeOptions, IpsmOptions, MapOptions};
 use shadowmap_rtw::{ImportanceOptions, WarpOptions};
 use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 
@@ -60,6 +60,10 @@ pub enum Technique {
     /// rotation, cut, single or dual; `fit` picks the paper's averaged cone or the
     /// exact minimal cone. Point light.
     Ipsm(IpsmOptions),
+    /// Cube shadow maps: six 90-degree perspective faces around the light, the faces
+    /// that miss the visible receivers skipped, each kept face focused on them (or,
+    /// with `focused` off, the full face over the light's range). Point light.
+    CubeMaps(CubeOptions),
 }
 
 /// Splits of the cascaded techniques: practical splits (Zhang et al.) of the eye's
@@ -236,7 +240,7 @@ impl LightKind {
 impl Technique {
     /// Every technique with default options, in report order.
     #[must_use]
-    pub fn all_default() -> [Self; 14] {
+    pub fn all_default() -> [Self; 16] {
         let plan = CascadePlan::default();
         let rtw = RtwPlan::default();
         [
@@ -257,6 +261,8 @@ impl Technique {
             Self::Dpsm(DpsmOptions::default()),
             Self::Ipsm(IpsmOptions::default().with_fit(ConeFit::Paper)),
             Self::Ipsm(IpsmOptions::default().with_fit(ConeFit::Exact)),
+            Self::CubeMaps(CubeOptions::default()),
+            Self::CubeMaps(CubeOptions::default().with_focused(false)),
         ]
     }
 
@@ -281,6 +287,13 @@ impl Technique {
                 ConeFit::Paper => "ipsm_paper",
                 ConeFit::Exact => "ipsm_exact",
             },
+            Self::CubeMaps(o) => {
+                if o.focused {
+                    "cube"
+                } else {
+                    "cube_unfocused"
+                }
+            }
         }
     }
 
@@ -289,7 +302,7 @@ impl Technique {
     pub const fn light_kind(&self) -> LightKind {
         match self {
             Self::SpotFit { .. } => LightKind::Spot,
-            Self::Dpsm(_) | Self::Ipsm(_) => LightKind::Point,
+            Self::Dpsm(_) | Self::Ipsm(_) | Self::CubeMaps(_) => LightKind::Point,
             _ => LightKind::Directional,
         }
     }

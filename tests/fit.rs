@@ -187,7 +187,9 @@ proptest! {
         let Ok(slice) = camera.slice(near, far) else { return Ok(()) };
         for technique in of_kind(LightKind::Point) {
             let Ok(shadow) = fit(&technique, &fit_input) else { continue };
-            let map = shadow.paraboloid().unwrap();
+            // Cube maps cover the visible receivers, not the whole truncated frustum:
+            // their own property tests check them.
+            let Some(map) = shadow.paraboloid() else { continue };
             // The truncated frustum's corners and centre, where the light reaches them.
             let centre = slice.corners.iter().copied().sum::<Vec3>() / 8.0;
             let lit: Vec<Vec3> = slice

@@ -12,16 +12,18 @@
 //! |---|---|
 //! | directional | uniform focused, stable and tight cascades (PSSM over the depth bounds), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), auto (the candidate with the lowest predicted error), RTW (backward importance), RTW oracle |
 //! | spot | spot fit |
-//! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone |
+//! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone, cube maps focused on the visible receivers, cube maps of full faces |
 //!
 //! Budget: `texel_budget` texels in total ([`TechniqueOptions`], default `1024²`),
 //! split evenly over the layers: one `1024²` map, four cascades of `512²`, a dual
 //! paraboloid of `2 x 724²` (an IPSM plan that falls back to dual gets `2 x 724²`
-//! too). A technique that cannot handle a frame returns
+//! too; cube maps share it over their kept faces, `k x floor(sqrt(1024² / k))²`). A technique that cannot handle a frame returns
 //! [`EvalError::Technique`] with the math crate's reason, never panics.
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
-use shadowmap::paraboloid::{ConeFit, IpsmOptions, Side, SubdivisionOptions, subdivide_triangles};
+use shadowmap::paraboloid::{
+    ConeFit, CubeOptions, IpsmOptions, Side, SubdivisionOptions, subdivide_triangles,
+};
 use shadowmap::rtw::{EyeSample, RtwSubdivision, subdivide_for_rtw};
 use shadowmap::{CascadePlan, FitInput, Fitted, RtwPlan, Shadow, depth_bounds_of, fit};
 use shadowmap_frustum::{Camera, Light, SceneBounds, ShadowMapping, ShadowSample};
@@ -78,11 +80,16 @@ pub enum TechniqueKind {
     IpsmPaper,
     /// IPSM with the exact minimal cone.
     IpsmExact,
+    /// Cube maps: the faces that see visible receivers, each focused on them
+    /// (`shadowmap_paraboloid::CubeMap`); the point lights' baseline.
+    Cube,
+    /// Cube maps with the same faces at their full 90 degrees over the light's range.
+    CubeUnfocused,
 }
 
 impl TechniqueKind {
     /// All techniques, in report order.
-    pub const ALL: [Self; 14] = [
+    pub const ALL: [Self; 16] = [
         Self::UniformFocused,
         Self::StableCascades,
         Self::TightCascades,
@@ -97,6 +104,8 @@ impl TechniqueKind {
         Self::Dpsm,
         Self::IpsmPaper,
         Self::IpsmExact,
+        Self::Cube,
+        Self::CubeUnfocused,
     ];
 
     /// Short identifier for tables and file names.
@@ -117,6 +126,8 @@ impl TechniqueKind {
             Self::Dpsm => "dpsm",
             Self::IpsmPaper => "ipsm_paper",
             Self::IpsmExact => "ipsm_exact",
+            Self::Cube => "cube",
+            Self::CubeUnfocused => "cube_unfocused",
         }
     }
 
@@ -156,6 +167,8 @@ impl TechniqueKind {
             Self::Dpsm => T::Dpsm(Default::default()),
             Self::IpsmPaper => ipsm(ConeFit::Paper),
             Self::IpsmExact => ipsm(ConeFit::Exact),
+            Self::Cube => T::CubeMaps(CubeOptions::default()),
+            Self::CubeUnfocused => T::CubeMaps(CubeOptions::default().with_focused(false)),
         }
     }
 
@@ -381,6 +394,18 @@ impl Technique {
         }
         match self.shadow.fitted() {
             Fitted::Cascades(set) => rasterize_depth(mesh, &MatrixProjector::from(set), &options),
+            Fitted::Cube(cube) => {
+                let matrices = cube
+                    .faces
+                    .iter()
+                    .map(|f| f.clip_from_world.as_dmat4())
+                    .collect();
+                rasterize_depth(
+                    mesh,
+                    &MatrixProjector::new(matrices, cube.reversed_z),
+                    &options,
+                )
+            }
             Fitted::WarpedCascades { cascades, .. } => {
                 let matrices = cascades
                     .cascades

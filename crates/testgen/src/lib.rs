@@ -19,6 +19,8 @@ use shadowmap_frustum::{Aabb, Camera, Projection, SplitScheme, projection};
 
 pub use arbitrary;
 
+#[cfg(feature = "paraboloid")]
+pub mod cube;
 pub mod frustum;
 #[cfg(feature = "paraboloid")]
 pub mod paraboloid;

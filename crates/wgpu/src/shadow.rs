@@ -74,6 +74,7 @@ pub fn with_technique<R>(
         (Fitted::Dpsm(map), _) => ShadowTechnique::Paraboloid(map),
         (Fitted::Ipsm(plan), _) => ShadowTechnique::Paraboloid(&plan.map),
         (Fitted::WarpedCascades { cascades, .. }, _) => ShadowTechnique::WarpedCascades(cascades),
+        (Fitted::Cube(cube), _) => ShadowTechnique::Cube(cube),
         _ => return Err(UNSUPPORTED),
     };
     Ok(f(&technique))

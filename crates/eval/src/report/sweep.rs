@@ -5,7 +5,8 @@
 //! case, a technique *wins* when its p95 is below the baseline's divided by
 //! [`TIE_BAND`], *loses* when it is above the baseline's times [`TIE_BAND`], and ties
 //! otherwise; a technique or baseline without a p95 (n/a, nothing measured) counts
-//! as unmeasured. The baseline is the uniform fit of the light ([`baseline_of`]);
+//! as unmeasured. The baseline is the light's own ([`baseline_of`]: the uniform or spot
+//! fit, the focused cube maps for a point light);
 //! the RTW oracle is a bound, not a technique, and is not counted.
 
 use std::fmt::Write as _;
@@ -67,12 +68,14 @@ pub struct SweepSummary {
 
 /// The baseline among `techniques` (those of one light): the uniform fit for a
 /// directional light, the spot's own fit for a spot light (or the uniform fit where
-/// it applies), DPSM for a point light.
+/// it applies), the focused cube maps for a point light (DPSM where they are not
+/// among the techniques).
 #[must_use]
 pub fn baseline_of(techniques: &[TechniqueKind]) -> Option<TechniqueKind> {
     [
         TechniqueKind::UniformFocused,
         TechniqueKind::SpotFit,
+        TechniqueKind::Cube,
         TechniqueKind::Dpsm,
     ]
     .into_iter()

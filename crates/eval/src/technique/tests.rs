@@ -37,7 +37,7 @@ fn every_light_has_techniques() {
         range: 10.0,
     };
     assert_eq!(TechniqueKind::for_light(&d).len(), 10);
-    assert_eq!(TechniqueKind::for_light(&p).len(), 3);
+    assert_eq!(TechniqueKind::for_light(&p).len(), 5);
     assert!(!TechniqueKind::SpotFit.applies_to(&d));
 }
 
@@ -161,4 +161,60 @@ fn wrong_light_or_bad_frame_is_a_typed_error() {
     )
     .unwrap();
     assert_eq!((t.layers(), t.texels()), (4, 4 * 32 * 32));
+}
+
+/// Cube maps render one layer per kept face through the matrix depth pass, and a
+/// box over the ground shadows the ground point below it (on its own layer) but not
+/// a lit one.
+#[test]
+fn cube_maps_render_their_kept_faces() {
+    let camera = Camera::look_to(
+        Vec3::new(0.0, 3.0, 0.0),
+        Vec3::new(0.0, -0.3, -1.0),
+        Vec3::Y,
+        shadowmap_frustum::Projection::perspective(1.0, 1.5, 0.5, 100.0),
+    )
+    .unwrap();
+    let light = Light::Point {
+        position: Vec3::new(0.0, 10.0, -20.0),
+        range: 80.0,
+    };
+    let mut mesh = crate::scene::Mesh::new();
+    let (g0, g1) = (DVec3::new(-60.0, 0.0, -90.0), DVec3::new(60.0, 0.0, 10.0));
+    mesh.push_quad([
+        g0,
+        DVec3::new(g1.x, 0.0, g0.z),
+        g1,
+        DVec3::new(g0.x, 0.0, g1.z),
+    ]);
+    mesh.push_box(DVec3::new(-2.0, 4.0, -26.0), DVec3::new(2.0, 5.0, -22.0));
+    let b = mesh.bounds().unwrap();
+    let frame = frame_over(&camera, &light, b);
+    let o = TechniqueOptions::default().with_texel_budget(256 * 256);
+    for kind in [TechniqueKind::Cube, TechniqueKind::CubeUnfocused] {
+        let t = Technique::build(kind, &frame, &o).unwrap();
+        let cube = t.shadow().cube().unwrap();
+        assert!((1..6).contains(&t.layers()), "{}", t.layers());
+        assert_eq!(t.layers(), cube.layers());
+        let map = t.rasterize(&mesh, &RasterOptions::default()).unwrap();
+        assert_eq!(map.layers, t.layers());
+        let stored = |p: DVec3| {
+            let s = t.map_point(p).unwrap();
+            (f64::from(map.lookup(&s).unwrap()), s.depth)
+        };
+        // Below the box (shadowed): something nearer is stored.
+        let (occluder, ground) = stored(DVec3::new(0.0, 0.0, -30.0));
+        assert!(
+            occluder < ground - 1e-4,
+            "{}: {occluder} {ground}",
+            kind.name()
+        );
+        // Lit ground: the stored depth is the ground's own.
+        let (stored_lit, lit) = stored(DVec3::new(15.0, 0.0, -40.0));
+        assert!(
+            (stored_lit - lit).abs() < 2e-3,
+            "{}: {stored_lit} {lit}",
+            kind.name()
+        );
+    }
 }

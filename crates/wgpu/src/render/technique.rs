@@ -1,9 +1,10 @@
 //! Which technique the renderer draws: its lookup shader, light, depth direction
 //! and uniform blocks, chosen in one match per question.
 
+use bytemuck::Zeroable;
 use glam::Mat4;
 use shadowmap_frustum::{CascadeSet, LightDirection, ShadowTransform};
-use shadowmap_paraboloid::ParaboloidMap;
+use shadowmap_paraboloid::{CubeMap, ParaboloidMap};
 use shadowmap_rtw::RtwShadow;
 use shadowmap_warp::{WarpedCascades, XpsmShadow};
 
@@ -34,6 +35,11 @@ pub enum ShadowTechnique<'a> {
     /// where neighbours overlap, the lookup divided by `w`. A cascade without a fit
     /// (its slice has no receivers) renders nothing and reads as not covered.
     WarpedCascades(&'a WarpedCascades),
+    /// Cube shadow maps (`shadowmap_paraboloid::CubeMap`): one layer per kept face,
+    /// rendered with the face's perspective matrix; the lookup is the cascades'
+    /// selection by projection (the first face whose window holds the point, the
+    /// windows being disjoint up to rounding) with the `uv` divided by `w`.
+    Cube(&'a CubeMap),
 }
 
 /// Which lookup shader.
@@ -61,9 +67,10 @@ impl ShadowTechnique<'_> {
     pub(super) fn lookup(&self) -> Lookup {
         match self {
             Self::Matrix(_) | Self::Xpsm(_) => Lookup::Matrix,
-            Self::Cascades(_) | Self::CascadesByProjection(..) | Self::WarpedCascades(_) => {
-                Lookup::Cascades
-            }
+            Self::Cascades(_)
+            | Self::CascadesByProjection(..)
+            | Self::WarpedCascades(_)
+            | Self::Cube(_) => Lookup::Cascades,
             Self::Paraboloid(_) => Lookup::Paraboloid,
             Self::Rtw(_) => Lookup::Rtw,
         }
@@ -85,7 +92,7 @@ impl ShadowTechnique<'_> {
                 .find_map(|c| c.shadow.as_ref())
                 .map(|s| &s.transform),
             Self::Rtw(r) => Some(&r.base),
-            Self::Paraboloid(_) => None,
+            Self::Paraboloid(_) | Self::Cube(_) => None,
         }
     }
 
@@ -97,6 +104,7 @@ impl ShadowTechnique<'_> {
     pub(super) fn light(&self) -> Result<LightDirection, BackendError> {
         match self {
             Self::Paraboloid(m) => Ok(LightDirection::Position(m.position)),
+            Self::Cube(c) => Ok(LightDirection::Position(c.position)),
             _ => self
                 .first_transform()
                 .map(|t| t.light)
@@ -107,6 +115,7 @@ impl ShadowTechnique<'_> {
     pub(super) fn reversed_z(&self) -> bool {
         match self {
             Self::Paraboloid(m) => m.reversed_z,
+            Self::Cube(c) => c.reversed_z,
             _ => self.first_transform().is_some_and(|t| t.reversed_z),
         }
     }
@@ -119,6 +128,12 @@ impl ShadowTechnique<'_> {
             Self::Xpsm(x) => Some(vec![x.to_raw()]),
             Self::Cascades(s) | Self::CascadesByProjection(s, _) => Some(cascade_layers(s)),
             Self::WarpedCascades(w) => Some(warped_cascade_layers(w)),
+            Self::Cube(c) => Some(
+                (0..c.layers())
+                    .filter_map(|layer| c.transform(layer))
+                    .map(|t| t.to_raw())
+                    .collect(),
+            ),
             Self::Paraboloid(_) | Self::Rtw(_) => None,
         }
     }
@@ -139,7 +154,25 @@ impl ShadowTechnique<'_> {
                 bytemuck::bytes_of(&CascadeShadowRaw::from_warped(w, view_from_world)).to_vec()
             }
             Self::Paraboloid(m) => bytemuck::bytes_of(&m.to_raw()).to_vec(),
+            Self::Cube(c) => bytemuck::bytes_of(&cube_lookup(c)).to_vec(),
             Self::Rtw(r) => bytemuck::bytes_of(&r.to_raw()).to_vec(),
         }
     }
+}
+
+/// The cascades lookup block of a cube map: one perspective `uv_from_world` per kept
+/// face, selected by projection without a margin (adjacent windows meet at the face
+/// edges).
+fn cube_lookup(cube: &CubeMap) -> CascadeShadowRaw {
+    let mut raw = CascadeShadowRaw::zeroed();
+    let n = raw.uv_from_world.len();
+    for (slot, layer) in raw.uv_from_world.iter_mut().zip(0..cube.layers()) {
+        if let Some(t) = cube.transform(layer) {
+            *slot = t.uv_from_world.to_cols_array_2d();
+        }
+    }
+    raw.count = cube.layers().min(n as u32);
+    raw.reversed_z = u32::from(cube.reversed_z);
+    raw.select_by_projection = 1;
+    raw
 }
