@@ -13,7 +13,8 @@
 //!   into closed casters and open receivers, reporting the first open edge.
 //! - **Projective shadows** (Blinn, *Me and my (fake) shadow*, 1988): the occluders
 //!   drawn black on white from the light, projected onto separate receivers with
-//!   homogeneous texture coordinates ([`ProjectiveShadow`]).
+//!   homogeneous texture coordinates ([`ProjectiveShadow`]; [`OccluderMask`] is the
+//!   CPU reference of the mask and its lookup).
 //!
 //! The crate needs `alloc` (meshes and volumes are buffers) and builds `no_std` with
 //! the `libm` feature.
@@ -60,9 +61,11 @@ extern crate alloc;
 mod error;
 mod mesh;
 mod projection;
+mod projective;
 mod volume;
 
 pub use error::VolumeError;
 pub use mesh::{Edge, EdgeMesh, Partition};
 pub use projection::{ProjectiveShadow, infinite_clip_from_world};
+pub use projective::{MAX_MASK_SIDE, OccluderMask};
 pub use volume::{ShadowVolume, silhouette_edges};

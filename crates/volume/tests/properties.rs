@@ -6,7 +6,8 @@ use glam::{DMat3, DVec3, Mat4, Vec3, Vec4};
 use proptest::prelude::*;
 use shadowmap_frustum::{Aabb, Camera, Light, Projection};
 use shadowmap_volume::{
-    EdgeMesh, Partition, ProjectiveShadow, ShadowVolume, VolumeError, infinite_clip_from_world,
+    EdgeMesh, OccluderMask, Partition, ProjectiveShadow, ShadowVolume, VolumeError,
+    infinite_clip_from_world,
 };
 
 /// A triangle soup under construction.
@@ -438,4 +439,55 @@ fn projective_shadow_frames_the_occluders() {
         ProjectiveShadow::new(&inside, &occluders),
         Err(VolumeError::InvalidOccluders)
     );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// A ground point straight down-light of a convex occluder's centre is in its
+    /// projective shadow; one outside the occluder's shadow cylinder or cone, or
+    /// behind a point light, is not.
+    #[test]
+    fn projective_mask_shadows_points_behind_occluders(soup in convex(), light in light()) {
+        let bounds = Aabb::from_points(&soup.positions).unwrap();
+        let shadow = ProjectiveShadow::new(&light, &bounds).unwrap();
+        let mask = OccluderMask::render(&shadow, &soup.positions, &soup.indices, 256).unwrap();
+        let centre = soup.positions.iter().map(|p| p.as_dvec3()).sum::<DVec3>()
+            / soup.positions.len() as f64;
+        let origin = light_origin(&light);
+        let away = match light {
+            Light::Directional { direction } => direction.as_dvec3().normalize(),
+            _ => (centre - origin).normalize(),
+        };
+        prop_assert!(mask.shadows(&shadow, (centre + away * 30.0).as_vec3()));
+        // Sideways, well past the bounds: outside the mask's shadow.
+        let side = away.any_orthonormal_vector();
+        let radius = f64::from(bounds.size().length());
+        let beside = centre + side * (radius + 1.0) * 3.0 + away * 2.0;
+        prop_assert!(!mask.shadows(&shadow, beside.as_vec3()));
+        if let Light::Point { position, .. } = light {
+            let behind = position.as_dvec3() - away * 5.0;
+            prop_assert!(!mask.shadows(&shadow, behind.as_vec3()));
+        }
+    }
+}
+
+#[test]
+fn occluder_mask_rejects_bad_input() {
+    let occluders = Aabb::new(Vec3::ZERO, Vec3::ONE);
+    let light = Light::Directional {
+        direction: Vec3::NEG_Y,
+    };
+    let s = ProjectiveShadow::new(&light, &occluders).unwrap();
+    let p = [Vec3::ZERO, Vec3::X, Vec3::Z];
+    assert_eq!(
+        OccluderMask::render(&s, &p, &[[0, 1, 2]], 0),
+        Err(VolumeError::InvalidOccluders)
+    );
+    assert_eq!(
+        OccluderMask::render(&s, &p, &[[0, 1, 3]], 8),
+        Err(VolumeError::IndexOutOfRange { triangle: 0 })
+    );
+    let m = OccluderMask::render(&s, &p, &[[0, 1, 2]], 8).unwrap();
+    assert!(m.occluded.iter().any(|&o| o) && !m.occluded.iter().all(|&o| o));
 }
