@@ -273,59 +273,23 @@ impl ProjectiveRenderer {
             let [occluder_mesh, receiver_mesh] = meshes;
             let (occluder_mesh, receiver_mesh) = (occluder_mesh?, receiver_mesh?);
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("shadowmap projective occluder mask"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &mask_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: clear(wgpu::Color::TRANSPARENT),
-                    })],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                if let Some(mesh) = &occluder_mesh {
-                    pass.set_pipeline(&pipelines.occluder_mask);
-                    pass.set_bind_group(0, &uniforms, &[]);
-                    draw(&mut pass, mesh);
-                }
-            }
+            mask_pass(
+                &mut encoder,
+                &mask_view,
+                pipelines,
+                &uniforms,
+                occluder_mesh.as_ref(),
+            );
             let class_view = class.create_view(&Default::default());
             let depth_view = depth.create_view(&Default::default());
-            {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("shadowmap projective camera"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &class_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: clear(wgpu::Color::TRANSPARENT),
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &depth_view,
-                        depth_ops: Some(clear(if camera.reversed_z { 0.0 } else { 1.0 })),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                let reversed = usize::from(camera.reversed_z);
-                pass.set_bind_group(0, &uniforms, &[]);
-                pass.set_bind_group(1, &mask_group, &[]);
-                for (mesh, pipeline) in [
-                    (&occluder_mesh, &pipelines.occluders[reversed]),
-                    (&receiver_mesh, &pipelines.receivers[reversed]),
-                ] {
-                    if let Some(mesh) = mesh {
-                        pass.set_pipeline(pipeline);
-                        draw(&mut pass, mesh);
-                    }
-                }
-            }
+            let meshes = [occluder_mesh.as_ref(), receiver_mesh.as_ref()];
+            camera_pass(
+                &mut encoder,
+                (&class_view, &depth_view, camera.reversed_z),
+                pipelines,
+                [&uniforms, &mask_group],
+                meshes,
+            );
             ctx.queue.submit([encoder.finish()]);
             let classes = ctx.read_texture(&class, wgpu::TextureAspect::All)?;
             Ok(decode(width, height, &classes))
@@ -337,4 +301,71 @@ fn draw(pass: &mut wgpu::RenderPass<'_>, mesh: &MeshBuffers) {
     pass.set_vertex_buffer(0, mesh.vertices.slice(..));
     pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
     pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+}
+
+/// Draws the occluders from the light into the mask.
+fn mask_pass(
+    encoder: &mut wgpu::CommandEncoder,
+    view: &wgpu::TextureView,
+    pipelines: &Pipelines,
+    uniforms: &wgpu::BindGroup,
+    occluders: Option<&MeshBuffers>,
+) {
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("shadowmap projective occluder mask"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: clear(wgpu::Color::TRANSPARENT),
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    if let Some(mesh) = occluders {
+        pass.set_pipeline(&pipelines.occluder_mask);
+        pass.set_bind_group(0, uniforms, &[]);
+        draw(&mut pass, mesh);
+    }
+}
+
+/// Draws the camera's view: occluders lit, receivers through the mask.
+fn camera_pass(
+    encoder: &mut wgpu::CommandEncoder,
+    (class_view, depth_view, reversed_z): (&wgpu::TextureView, &wgpu::TextureView, bool),
+    pipelines: &Pipelines,
+    [uniforms, mask]: [&wgpu::BindGroup; 2],
+    [occluders, receivers]: [Option<&MeshBuffers>; 2],
+) {
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("shadowmap projective camera"),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: class_view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: clear(wgpu::Color::TRANSPARENT),
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth_view,
+            depth_ops: Some(clear(if reversed_z { 0.0 } else { 1.0 })),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    let reversed = usize::from(reversed_z);
+    pass.set_bind_group(0, uniforms, &[]);
+    pass.set_bind_group(1, mask, &[]);
+    for (mesh, pipeline) in [
+        (occluders, &pipelines.occluders[reversed]),
+        (receivers, &pipelines.receivers[reversed]),
+    ] {
+        if let Some(mesh) = mesh {
+            pass.set_pipeline(pipeline);
+            draw(&mut pass, mesh);
+        }
+    }
 }
