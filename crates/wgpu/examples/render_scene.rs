@@ -4,7 +4,10 @@
 //! (`HeadlessRenderer::render_shadow`) with no per-technique code.
 //!
 //! Renders the city block with every technique and writes one PNG per technique to
-//! `rendered/` of the report directory (`--out`, default `target/shadowmap-report`
+//! `rendered/` of the report directory, and beside it the technique's
+//! misclassification against exact stencil shadow volumes at the render resolution:
+//! `<technique>_misclassified.png` (red falsely lit, blue falsely shadowed) and one
+//! row per technique in `misclassification.csv` (`--out`, default `target/shadowmap-report`
 //! relative to the working directory, as for `compare`). The `index.html` that
 //! `compare` writes shows them; `compare` keeps `rendered/` when it replaces the
 //! report.
@@ -23,7 +26,8 @@ use shadowmap_eval::mask::GBuffer;
 use shadowmap_eval::scene::Scene;
 use shadowmap_eval::technique::eye_samples;
 use shadowmap_wgpu::GpuContext;
-use shadowmap_wgpu::render::{HeadlessRenderer, RenderOptions, ShadowFilter};
+use shadowmap_wgpu::render::{HeadlessRenderer, RenderOptions, ShadowFilter, ShadowMask};
+use shadowmap_wgpu::volume::{VolumeMethod, VolumeRenderer, VolumeScene, misclassification};
 
 /// Image size, and the G-buffer's (a quarter in each direction: enough samples for
 /// RTW's importance and the cascades' depth bounds).
@@ -100,11 +104,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         });
     let pixels_per_radian = HEIGHT as f32 / 2.0 / (55f32.to_radians() / 2.0).tan();
 
+    // The exact shadows of each light (z-fail: right wherever the camera is).
+    let mut volumes = VolumeScene::new(&triangles)?;
+    if let Some(open) = volumes.first_open_edge() {
+        eprintln!(
+            "{} open triangles receive but cast no volume ({open})",
+            volumes.open_triangles()
+        );
+    }
+    let mut volume_renderer = VolumeRenderer::new();
+    let mut exact = |light: &Light| -> Result<ShadowMask, Box<dyn std::error::Error>> {
+        Ok(volume_renderer.render_mask(
+            &ctx,
+            &mut volumes,
+            &camera,
+            light,
+            (WIDTH, HEIGHT),
+            VolumeMethod::ZFail,
+        )?)
+    };
+    let (sun_exact, lamp_exact) = (exact(&sun)?, exact(&lamp)?);
+    let mut csv =
+        String::from("technique,compared_pixels,false_lit,false_shadowed,misclassification\n");
+
     let mut renderer = HeadlessRenderer::new();
     for technique in Technique::all_default() {
-        let light = match technique.light_kind() {
-            LightKind::Directional => &sun,
-            LightKind::Point => &lamp,
+        let (light, truth) = match technique.light_kind() {
+            LightKind::Directional => (&sun, &sun_exact),
+            LightKind::Point => (&lamp, &lamp_exact),
             _ => continue,
         };
         let input = FitInput::new(&camera, light, scene_bounds, BUDGET)
@@ -114,13 +141,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let frame = renderer.render_shadow(&ctx, &triangles, &camera, &shadow, &options)?;
         let path = dir.join(format!("{}.png", technique.name()));
         frame.image.save_png(&path)?;
+        let (miss, diff) = misclassification(&frame.mask, truth);
+        diff.save_png(dir.join(format!("{}_misclassified.png", technique.name())))?;
+        csv.push_str(&format!(
+            "{},{},{},{},{:.6}\n",
+            technique.name(),
+            miss.compared,
+            miss.false_lit,
+            miss.false_shadowed,
+            miss.rate()
+        ));
         eprintln!(
-            "wrote {} ({} layer(s) of {}²)",
+            "wrote {} ({} layer(s) of {}²; {:.3}% misclassified)",
             path.display(),
             shadow.layers(),
-            shadow.layer_side()
+            shadow.layer_side(),
+            100.0 * miss.rate()
         );
     }
+    let csv_path = dir.join("misclassification.csv");
+    std::fs::write(&csv_path, csv).map_err(|e| format!("{}: {e}", csv_path.display()))?;
+    eprintln!("wrote {}", csv_path.display());
     // The same stable cascades, filtered with variance shadow maps.
     let input = FitInput::new(&camera, &sun, scene_bounds, BUDGET).with_eye_samples(&samples);
     let cascades = fit(&Technique::StableCascades(Default::default()), &input)?;

@@ -19,6 +19,7 @@
 //! | [`profile`] | [`profile::GpuProfiler`]: GPU time per pass from timestamp queries |
 //! | [`reduce`] | depth min/max reduction (SDSM, IPSM depth bounds) |
 //! | [`rtw`] | [`rtw::GpuRtw`]: importance, blur, warp tables on the GPU |
+//! | [`volume`] | [`volume::VolumeRenderer`]: stencil shadow volumes (z-pass, z-fail with caps), the exact mask; [`volume::misclassification`] of any technique against it; [`volume::ProjectiveRenderer`]: projective shadows |
 //! | [`shaders`] | every WGSL source, embedded |
 //!
 //! # Example
@@ -154,6 +155,9 @@ pub mod uniforms;
 pub mod reduce;
 pub mod rtw;
 
+// --- shadow volumes and projective shadows ---
+pub mod volume;
+
 /// The WGSL sources in `shaders/`, embedded so users need no file access.
 pub mod shaders {
     // Each author adds `pub const NAME: &str = include_str!("../shaders/<file>.wgsl");`
@@ -200,4 +204,12 @@ pub mod shaders {
     pub const RTW_IMPORTANCE: &str = include_str!("../shaders/rtw_importance.wgsl");
     /// RTW per-axis blur, normalization, temporal smoothing, floor and warp table.
     pub const RTW_WARP: &str = include_str!("../shaders/rtw_warp.wgsl");
+
+    // --- shadow volumes, projective shadows (volume_*, projective_*) ---
+    /// Stencil shadow volumes: surfaces, two-sided stencil count, classification.
+    pub const VOLUME_STENCIL: &str = include_str!("../shaders/volume_stencil.wgsl");
+    /// Silhouette edges of a closed mesh for one light (compute, one edge per invocation).
+    pub const VOLUME_SILHOUETTE: &str = include_str!("../shaders/volume_silhouette.wgsl");
+    /// Projective shadows: occluder mask from the light, receivers' homogeneous lookup.
+    pub const PROJECTIVE_SHADOW: &str = include_str!("../shaders/projective_shadow.wgsl");
 }
