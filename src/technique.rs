@@ -60,6 +60,20 @@ pub enum Technique {
     /// rotation, cut, single or dual; `fit` picks the paper's averaged cone or the
     /// exact minimal cone. Point light.
     Ipsm(IpsmOptions),
+    /// Rectilinear texture warping (Rosen) over the spot fit: the spot's perspective
+    /// projection is the base, importance from the eye's samples (backward analysis,
+    /// scaled by the base's texel footprint, which grows with the light depth). Spot
+    /// light.
+    SpotRtw(RtwPlan),
+    /// Rectilinear texture warping (Rosen) over the IPSM paraboloid (Vanek et al.):
+    /// each side's `uv` is the base, importance from the eye's samples scaled by the
+    /// paraboloid's footprint, one pair of warp tables per side. Point light.
+    PointRtw {
+        /// The paraboloid plan (cone fit, cut, single or dual).
+        ipsm: IpsmOptions,
+        /// The warp.
+        rtw: RtwPlan,
+    },
 }
 
 /// Splits of the cascaded techniques: practical splits (Zhang et al.) of the eye's
@@ -281,6 +295,8 @@ impl Technique {
                 ConeFit::Paper => "ipsm_paper",
                 ConeFit::Exact => "ipsm_exact",
             },
+            Self::SpotRtw(_) => "spot_rtw",
+            Self::PointRtw { .. } => "point_rtw",
         }
     }
 
@@ -288,8 +304,8 @@ impl Technique {
     #[must_use]
     pub const fn light_kind(&self) -> LightKind {
         match self {
-            Self::SpotFit { .. } => LightKind::Spot,
-            Self::Dpsm(_) | Self::Ipsm(_) => LightKind::Point,
+            Self::SpotFit { .. } | Self::SpotRtw(_) => LightKind::Spot,
+            Self::Dpsm(_) | Self::Ipsm(_) | Self::PointRtw { .. } => LightKind::Point,
             _ => LightKind::Directional,
         }
     }

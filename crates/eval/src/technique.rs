@@ -11,8 +11,8 @@
 //! | light | techniques |
 //! |---|---|
 //! | directional | uniform focused, stable and tight cascades (PSSM over the depth bounds), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), auto (the candidate with the lowest predicted error), RTW (backward importance), RTW oracle |
-//! | spot | spot fit |
-//! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone |
+//! | spot | spot fit, RTW over the spot fit |
+//! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone, RTW over the IPSM paraboloid |
 //!
 //! Budget: `texel_budget` texels in total ([`TechniqueOptions`], default `1024²`),
 //! split evenly over the layers: one `1024²` map, four cascades of `512²`, a dual
@@ -22,7 +22,9 @@
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap::paraboloid::{ConeFit, IpsmOptions, Side, SubdivisionOptions, subdivide_triangles};
-use shadowmap::rtw::{EyeSample, RtwSubdivision, subdivide_for_rtw};
+use shadowmap::rtw::{
+    EyeSample, RtwSubdivision, WarpMaps, subdivide_for_rtw, subdivide_for_rtw_with,
+};
 use shadowmap::{CascadePlan, FitInput, Fitted, RtwPlan, Shadow, depth_bounds_of, fit};
 use shadowmap_frustum::{Camera, Light, SceneBounds, ShadowMapping, ShadowSample};
 
@@ -37,6 +39,9 @@ use crate::scene::Mesh;
 mod auto;
 #[cfg(test)]
 mod tests;
+mod warped;
+
+use warped::WarpedProjector;
 
 pub use auto::AUTO_CANDIDATES;
 
@@ -78,11 +83,17 @@ pub enum TechniqueKind {
     IpsmPaper,
     /// IPSM with the exact minimal cone.
     IpsmExact,
+    /// Rectilinear texture warping over the spot fit (a perspective base), importance
+    /// from the eye's samples.
+    SpotRtw,
+    /// Rectilinear texture warping over each side of the IPSM paraboloid (exact
+    /// cone), importance from the eye's samples.
+    PointRtw,
 }
 
 impl TechniqueKind {
     /// All techniques, in report order.
-    pub const ALL: [Self; 14] = [
+    pub const ALL: [Self; 16] = [
         Self::UniformFocused,
         Self::StableCascades,
         Self::TightCascades,
@@ -97,6 +108,8 @@ impl TechniqueKind {
         Self::Dpsm,
         Self::IpsmPaper,
         Self::IpsmExact,
+        Self::SpotRtw,
+        Self::PointRtw,
     ];
 
     /// Short identifier for tables and file names.
@@ -117,6 +130,8 @@ impl TechniqueKind {
             Self::Dpsm => "dpsm",
             Self::IpsmPaper => "ipsm_paper",
             Self::IpsmExact => "ipsm_exact",
+            Self::SpotRtw => "spot_rtw",
+            Self::PointRtw => "point_rtw",
         }
     }
 
@@ -156,6 +171,11 @@ impl TechniqueKind {
             Self::Dpsm => T::Dpsm(Default::default()),
             Self::IpsmPaper => ipsm(ConeFit::Paper),
             Self::IpsmExact => ipsm(ConeFit::Exact),
+            Self::SpotRtw => T::SpotRtw(rtw),
+            Self::PointRtw => T::PointRtw {
+                ipsm: IpsmOptions::default().with_fit(ConeFit::Exact),
+                rtw,
+            },
         }
     }
 
@@ -367,7 +387,7 @@ impl Technique {
             return rasterize_depth(mesh, &MatrixProjector::from(t), &options);
         }
         if let Some(map) = self.shadow.paraboloid() {
-            return self.rasterize_paraboloid(map, mesh, &options);
+            return self.rasterize_paraboloid(map, [None, None], mesh, &options);
         }
         if let Some(shadow) = self.shadow.rtw() {
             // The depth pass warps vertices only: the same crack-free caster
@@ -392,13 +412,20 @@ impl Technique {
                     .collect();
                 rasterize_depth(mesh, &MatrixProjector::new(matrices, false), &options)
             }
+            Fitted::PointRtw { plan, front, back } => {
+                self.rasterize_paraboloid(&plan.map, [Some(front), back.as_ref()], mesh, &options)
+            }
             _ => Err(fail(self.kind, &"no depth pass for this result")),
         }
     }
 
+    /// Each side of a paraboloid map from its subdivided mesh; a side with warp
+    /// tables (RTW over the paraboloid) is subdivided again for the warp (the RTW
+    /// rule measured on the side's warped projection) and its vertices warped.
     fn rasterize_paraboloid(
         &self,
         map: &shadowmap::paraboloid::ParaboloidMap,
+        warps: [Option<&WarpMaps>; 2],
         mesh: &Mesh,
         options: &RasterOptions,
     ) -> Result<DepthMap, EvalError> {
@@ -417,7 +444,16 @@ impl Technique {
                 inner: ParaboloidProjector::from(map),
                 layer,
             };
-            let d = rasterize_depth(&mesh_of(&pieces), &one, options)?;
+            let d = if let Some(warps) = warps.get(layer as usize).copied().flatten() {
+                let uv = |p: Vec3| map.project(p, which).map(|s| s.uv);
+                let rtw = RtwSubdivision::default().with_resolution(side);
+                let mut warped = Vec::new();
+                subdivide_for_rtw_with(uv, warps, &pieces, &rtw, &mut warped);
+                let inner = WarpedProjector { inner: one, warps };
+                rasterize_depth(&mesh_of(&warped), &inner, options)?
+            } else {
+                rasterize_depth(&mesh_of(&pieces), &one, options)?
+            };
             let at = layer as usize * per_layer;
             out.depth[at..at + per_layer].copy_from_slice(&d.depth);
         }

@@ -22,6 +22,8 @@ pub use arbitrary;
 pub mod frustum;
 #[cfg(feature = "paraboloid")]
 pub mod paraboloid;
+#[cfg(all(feature = "paraboloid", feature = "rtw"))]
+pub mod point_rtw;
 #[cfg(feature = "rtw")]
 pub mod rtw;
 #[cfg(feature = "serde")]
