@@ -3,14 +3,15 @@
 use alloc::vec::Vec;
 use core::fmt;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use shadowmap_frustum::math::{floor, powf, sqrt};
 use shadowmap_frustum::{
     Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, FrustumError,
-    Light, MAX_CASCADES, SceneBounds, SplitScheme, TechniqueSelector, fit_spot,
+    Light, MAX_CASCADES, SceneBounds, ShadowMapping, ShadowTransform, SplitScheme,
+    TechniqueSelector, fit_spot,
 };
-use shadowmap_paraboloid::{CubeMap, IpsmPlan, ParaboloidError, ParaboloidMap};
-use shadowmap_rtw::{EyeSample, ImportanceMap, OracleAxis, RtwError, WarpMaps};
+use shadowmap_paraboloid::{CubeMap, IpsmOptions, IpsmPlan, ParaboloidError, ParaboloidMap, Side};
+use shadowmap_rtw::{BasePoint, EyeSample, ImportanceMap, OracleAxis, RtwError, WarpMaps};
 use shadowmap_warp::{
     LispsmOptions, WarpError, lispsm, tsm, uniform_focused, warped_cascades, xpsm,
 };
@@ -242,8 +243,11 @@ fn fit_one(technique: &Technique, input: &FitInput<'_>) -> Result<(Fitted, u32),
             fit_cascades(plan, stable, direction, input)?
         }
         Technique::WarpedCascades { plan, lispsm } => fit_warped(plan, lispsm, direction, input)?,
-        Technique::Rtw(plan) => (fit_rtw(plan, false, direction, input)?, 1),
-        Technique::RtwOracle(plan) => (fit_rtw(plan, true, direction, input)?, 1),
+        Technique::Rtw(plan) | Technique::RtwOracle(plan) => {
+            let base = uniform_focused(camera, direction, scene, &Default::default())?;
+            let oracle = matches!(technique, Technique::RtwOracle(_));
+            (fit_rtw(plan, oracle, technique.name(), base, input)?, 1)
+        }
         Technique::SpotFit { reversed_z } => {
             let frustum = camera.frustum()?;
             let s = fit_spot(input.light, &frustum, Some(scene), *reversed_z)?;
@@ -262,6 +266,16 @@ fn fit_one(technique: &Technique, input: &FitInput<'_>) -> Result<(Fitted, u32),
         }
         // `fit_with_selector` handles `auto` before coming here.
         Technique::Auto(_) => return Err(FitError::NoCandidate),
+        Technique::SpotRtw(plan) => {
+            let frustum = camera.frustum()?;
+            let base = fit_spot(input.light, &frustum, Some(scene), false)?.transform;
+            (fit_rtw(plan, false, technique.name(), base, input)?, 1)
+        }
+        Technique::PointRtw { ipsm, rtw } => {
+            let fitted = fit_point_rtw(ipsm, rtw, input)?;
+            let layers = fitted.layer_count();
+            (fitted, layers)
+        }
     })
 }
 
@@ -344,20 +358,21 @@ fn cascade_splits(plan: &CascadePlan, input: &FitInput<'_>) -> Result<CascadeSpl
     Ok(CascadeSplits::new(&scheme, count, near, far)?.with_overlap(plan.overlap)?)
 }
 
+/// RTW over `base` (the uniform fit of a directional light, the spot fit of a spot
+/// light): importance from the eye samples, or the oracle's exact density.
 fn fit_rtw(
     plan: &RtwPlan,
     oracle: bool,
-    direction: Vec3,
+    name: &'static str,
+    base: ShadowTransform,
     input: &FitInput<'_>,
 ) -> Result<Fitted, FitError> {
-    let name = if oracle { "rtw_oracle" } else { "rtw" };
     let missing = |what| FitError::MissingInput {
         technique: name,
         input: what,
     };
     let samples = input.eye_samples.ok_or_else(|| missing("eye_samples"))?;
     let camera = input.camera;
-    let base = uniform_focused(camera, direction, &input.scene, &Default::default())?;
     let n = plan.importance_side;
     let mut map = ImportanceMap::new(n, n)?;
     let mut warps = WarpMaps::new(n, n)?;
@@ -388,6 +403,53 @@ fn fit_rtw(
     Ok(Fitted::Rtw { base, warps })
 }
 
+/// RTW over the IPSM paraboloid: per side, importance from the eye samples that side
+/// stores, in its `uv`, scaled by the paraboloid's footprint there (world extent of a
+/// unit of `uv` across the ray: `distance / sqrt(uv² per steradian)`), then that
+/// side's tables.
+fn fit_point_rtw(
+    ipsm: &IpsmOptions,
+    plan: &RtwPlan,
+    input: &FitInput<'_>,
+) -> Result<Fitted, FitError> {
+    let samples = input.eye_samples.ok_or(FitError::MissingInput {
+        technique: "point_rtw",
+        input: "eye_samples",
+    })?;
+    let ipsm = IpsmPlan::new(input.light, input.camera, input.depth_bounds, ipsm)?;
+    let map = ipsm.map;
+    let n = plan.importance_side;
+    let side_warps = |side: Side| -> Result<WarpMaps, FitError> {
+        let project = |p: DVec3| {
+            let s = map.map_point(p).filter(|s| s.layer == side.layer())?;
+            let world = p.as_vec3();
+            let per_sr = f64::from(map.texels_per_steradian(world, 1)?);
+            let toward_light = map.position.as_dvec3() - p;
+            Some(BasePoint {
+                uv: s.uv,
+                footprint: toward_light.length() / sqrt(per_sr),
+                toward_light,
+            })
+        };
+        let mut importance = ImportanceMap::new(n, n)?;
+        importance.accumulate_backward_with(project, samples, None, &plan.importance)?;
+        let mut warps = WarpMaps::new(n, n)?;
+        warps.build(&importance, &plan.warp)?;
+        Ok(warps)
+    };
+    let front = side_warps(Side::Front)?;
+    let back = if map.layers() == 2 {
+        Some(side_warps(Side::Back)?)
+    } else {
+        None
+    };
+    Ok(Fitted::PointRtw {
+        plan: ipsm,
+        front,
+        back,
+    })
+}
+
 fn fit_dpsm(options: &DpsmOptions, light: &Light) -> Result<ParaboloidMap, FitError> {
     let Light::Point { position, range } = *light else {
         return Err(FitError::Paraboloid(ParaboloidError::UnsupportedLight));
@@ -414,4 +476,50 @@ pub fn depth_bounds_of(camera: &Camera, samples: &[EyeSample]) -> Option<DepthBo
         }
     }
     (lo < hi).then_some(DepthBounds { min: lo, max: hi })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Fitted;
+    use proptest::prelude::*;
+    use shadowmap_testgen::point_rtw::{PointRtwCase, check_point_rtw, point_rtw_case};
+    use shadowmap_testgen::strategy;
+
+    /// Fits RTW over the paraboloid to a case and checks its coverage; the number of
+    /// samples checked (0 when the fit refuses the case, e.g. a spot light).
+    fn fit_and_check(case: &PointRtwCase) -> usize {
+        let input = FitInput::new(
+            &case.plan.camera,
+            &case.plan.light,
+            // IPSM reads the camera and depth bounds, not the scene.
+            SceneBounds::whole(shadowmap_frustum::Aabb::new(Vec3::splat(-1.0), Vec3::ONE)),
+            1 << 16,
+        )
+        .with_eye_samples(&case.samples)
+        .with_depth_bounds(case.plan.bounds);
+        let technique = Technique::PointRtw {
+            ipsm: case.plan.options,
+            rtw: RtwPlan::default().with_importance_side(32),
+        };
+        let Ok(shadow) = fit(&technique, &input) else {
+            return 0;
+        };
+        let Fitted::PointRtw { plan, .. } = shadow.fitted() else {
+            panic!("point_rtw fitted something else");
+        };
+        assert_eq!(shadow.layers(), plan.map.layers());
+        check_point_rtw(case, &plan.map, &shadow)
+    }
+
+    proptest! {
+        #![proptest_config(shadowmap_testgen::proptest_config())]
+
+        /// Every sample the IPSM paraboloid stores is stored by RTW over it, in the
+        /// same layer, with the same depth, inside the map.
+        #[test]
+        fn point_rtw_covers_what_the_paraboloid_covers(case in strategy(point_rtw_case)) {
+            fit_and_check(&case);
+        }
+    }
 }

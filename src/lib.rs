@@ -80,6 +80,8 @@
 //! | `Dpsm` | point | 2 | | Brabec, Annen and Seidel, *Shadow mapping for hemispherical and omnidirectional light sources* |
 //! | `Ipsm` | point | 1 or 2 | D | Vanek, Navrátil, Herout and Zemčík, *High-quality shadows with improved paraboloid mapping*; `ConeFit::Exact` uses the exact minimal enclosing cone |
 //! | `CubeMaps` | point | 1..=6 | D | cube shadow maps, the engines' point-light baseline: the faces that see visible receivers, each focused on them (`CubeOptions::focused`) |
+//! | `SpotRtw` | spot | 1 | **S** | Rosen's RTW over the spot fit (a perspective base) |
+//! | `PointRtw` | point | 1 or 2 | **S**, D | Rosen's RTW over each side of the IPSM paraboloid |
 //!
 //! Cascade count: with depth bounds of ratio `r = max / min` and `k` maps sharing the
 //! budget, each cascade of a logarithmic split covers a ratio `r^(1/k)` on `side(k)`
@@ -96,7 +98,7 @@
 //!
 //! [`fit`] never panics: [`FitError`] says which input is wrong or missing, or wraps
 //! the math crate's own error. Every fit is allocation-free except RTW (its
-//! importance map and warp tables) and the RTW oracle.
+//! importance map and warp tables), the RTW oracle and RTW over the spot fit and the paraboloid.
 #![cfg_attr(not(feature = "std"), no_std)]
 
 #[cfg(feature = "frustum")]

@@ -39,9 +39,10 @@ pub enum Fitted {
         /// The camera's unit viewing direction.
         forward: Vec3,
     },
-    /// RTW and the RTW oracle: the base fit and the warp tables.
+    /// RTW and the RTW oracle (over the uniform fit), RTW over the spot fit: the base
+    /// fit and the warp tables.
     Rtw {
-        /// The uniform fit that is warped.
+        /// The fit that is warped (orthographic or perspective).
         base: ShadowTransform,
         /// The warp tables.
         warps: WarpMaps,
@@ -54,6 +55,15 @@ pub enum Fitted {
     Ipsm(IpsmPlan),
     /// Cube shadow maps, one layer per kept face.
     Cube(CubeMap),
+    /// RTW over the IPSM paraboloid: the plan and one pair of warp tables per side.
+    PointRtw {
+        /// The paraboloid plan whose sides are warped.
+        plan: IpsmPlan,
+        /// The front side's tables.
+        front: WarpMaps,
+        /// The back side's tables (a dual map only).
+        back: Option<WarpMaps>,
+    },
 }
 
 /// A technique fitted to one frame by [`fit`](crate::fit): what was asked for, what
@@ -175,7 +185,7 @@ impl Fitted {
             Self::Cascades(set) => set.cascades.len(),
             Self::WarpedCascades { cascades, .. } => cascades.cascades.len(),
             Self::Dpsm(map) => map.layers() as usize,
-            Self::Ipsm(plan) => plan.map.layers() as usize,
+            Self::Ipsm(plan) | Self::PointRtw { plan, .. } => plan.map.layers() as usize,
             Self::Cube(cube) => cube.faces.len(),
             _ => 1,
         };
@@ -234,6 +244,11 @@ impl ShadowMapping for Shadow {
             Fitted::Dpsm(map) => map.map_point(world),
             Fitted::Ipsm(plan) => plan.map.map_point(world),
             Fitted::Cube(cube) => cube.map_point(world),
+            Fitted::PointRtw { plan, front, back } => {
+                let s = plan.map.map_point(world)?;
+                let warps = if s.layer == 0 { front } else { back.as_ref()? };
+                warps.warp_sample(s)
+            }
             Fitted::Uniform(t) => t.map_point(world),
             Fitted::Lispsm(LispsmShadow { transform, .. })
             | Fitted::Xpsm(XpsmShadow { transform, .. })

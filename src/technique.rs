@@ -64,6 +64,20 @@ pub enum Technique {
     /// that miss the visible receivers skipped, each kept face focused on them (or,
     /// with `focused` off, the full face over the light's range). Point light.
     CubeMaps(CubeOptions),
+    /// Rectilinear texture warping (Rosen) over the spot fit: the spot's perspective
+    /// projection is the base, importance from the eye's samples (backward analysis,
+    /// scaled by the base's texel footprint, which grows with the light depth). Spot
+    /// light.
+    SpotRtw(RtwPlan),
+    /// Rectilinear texture warping (Rosen) over the IPSM paraboloid (Vanek et al.):
+    /// each side's `uv` is the base, importance from the eye's samples scaled by the
+    /// paraboloid's footprint, one pair of warp tables per side. Point light.
+    PointRtw {
+        /// The paraboloid plan (cone fit, cut, single or dual).
+        ipsm: IpsmOptions,
+        /// The warp.
+        rtw: RtwPlan,
+    },
 }
 
 /// Splits of the cascaded techniques: practical splits (Zhang et al.) of the eye's
@@ -294,6 +308,8 @@ impl Technique {
                     "cube_unfocused"
                 }
             }
+            Self::SpotRtw(_) => "spot_rtw",
+            Self::PointRtw { .. } => "point_rtw",
         }
     }
 
@@ -301,8 +317,10 @@ impl Technique {
     #[must_use]
     pub const fn light_kind(&self) -> LightKind {
         match self {
-            Self::SpotFit { .. } => LightKind::Spot,
-            Self::Dpsm(_) | Self::Ipsm(_) | Self::CubeMaps(_) => LightKind::Point,
+            Self::SpotFit { .. } | Self::SpotRtw(_) => LightKind::Spot,
+            Self::Dpsm(_) | Self::Ipsm(_) | Self::CubeMaps(_) | Self::PointRtw { .. } => {
+                LightKind::Point
+            }
             _ => LightKind::Directional,
         }
     }

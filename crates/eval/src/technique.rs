@@ -11,8 +11,8 @@
 //! | light | techniques |
 //! |---|---|
 //! | directional | uniform focused, stable and tight cascades (PSSM over the depth bounds), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), auto (the candidate with the lowest predicted error), RTW (backward importance), RTW oracle |
-//! | spot | spot fit |
-//! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone, cube maps focused on the visible receivers, cube maps of full faces |
+//! | spot | spot fit, RTW over the spot fit |
+//! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone, cube maps focused on the visible receivers, cube maps of full faces, RTW over the IPSM paraboloid |
 //!
 //! Budget: `texel_budget` texels in total ([`TechniqueOptions`], default `1024²`),
 //! split evenly over the layers: one `1024²` map, four cascades of `512²`, a dual
@@ -24,7 +24,9 @@ use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap::paraboloid::{
     ConeFit, CubeOptions, IpsmOptions, Side, SubdivisionOptions, subdivide_triangles,
 };
-use shadowmap::rtw::{EyeSample, RtwSubdivision, subdivide_for_rtw};
+use shadowmap::rtw::{
+    EyeSample, RtwSubdivision, WarpMaps, subdivide_for_rtw, subdivide_for_rtw_with,
+};
 use shadowmap::{CascadePlan, FitInput, Fitted, RtwPlan, Shadow, depth_bounds_of, fit};
 use shadowmap_frustum::{Camera, Light, SceneBounds, ShadowMapping, ShadowSample};
 
@@ -39,6 +41,9 @@ use crate::scene::Mesh;
 mod auto;
 #[cfg(test)]
 mod tests;
+mod warped;
+
+use warped::WarpedProjector;
 
 pub use auto::AUTO_CANDIDATES;
 
@@ -85,11 +90,17 @@ pub enum TechniqueKind {
     Cube,
     /// Cube maps with the same faces at their full 90 degrees over the light's range.
     CubeUnfocused,
+    /// Rectilinear texture warping over the spot fit (a perspective base), importance
+    /// from the eye's samples.
+    SpotRtw,
+    /// Rectilinear texture warping over each side of the IPSM paraboloid (exact
+    /// cone), importance from the eye's samples.
+    PointRtw,
 }
 
 impl TechniqueKind {
     /// All techniques, in report order.
-    pub const ALL: [Self; 16] = [
+    pub const ALL: [Self; 18] = [
         Self::UniformFocused,
         Self::StableCascades,
         Self::TightCascades,
@@ -106,6 +117,8 @@ impl TechniqueKind {
         Self::IpsmExact,
         Self::Cube,
         Self::CubeUnfocused,
+        Self::SpotRtw,
+        Self::PointRtw,
     ];
 
     /// Short identifier for tables and file names.
@@ -128,6 +141,8 @@ impl TechniqueKind {
             Self::IpsmExact => "ipsm_exact",
             Self::Cube => "cube",
             Self::CubeUnfocused => "cube_unfocused",
+            Self::SpotRtw => "spot_rtw",
+            Self::PointRtw => "point_rtw",
         }
     }
 
@@ -169,6 +184,11 @@ impl TechniqueKind {
             Self::IpsmExact => ipsm(ConeFit::Exact),
             Self::Cube => T::CubeMaps(CubeOptions::default()),
             Self::CubeUnfocused => T::CubeMaps(CubeOptions::default().with_focused(false)),
+            Self::SpotRtw => T::SpotRtw(rtw),
+            Self::PointRtw => T::PointRtw {
+                ipsm: IpsmOptions::default().with_fit(ConeFit::Exact),
+                rtw,
+            },
         }
     }
 
@@ -380,7 +400,7 @@ impl Technique {
             return rasterize_depth(mesh, &MatrixProjector::from(t), &options);
         }
         if let Some(map) = self.shadow.paraboloid() {
-            return self.rasterize_paraboloid(map, mesh, &options);
+            return self.rasterize_paraboloid(map, [None, None], mesh, &options);
         }
         if let Some(shadow) = self.shadow.rtw() {
             // The depth pass warps vertices only: the same crack-free caster
@@ -417,13 +437,20 @@ impl Technique {
                     .collect();
                 rasterize_depth(mesh, &MatrixProjector::new(matrices, false), &options)
             }
+            Fitted::PointRtw { plan, front, back } => {
+                self.rasterize_paraboloid(&plan.map, [Some(front), back.as_ref()], mesh, &options)
+            }
             _ => Err(fail(self.kind, &"no depth pass for this result")),
         }
     }
 
+    /// Each side of a paraboloid map from its subdivided mesh; a side with warp
+    /// tables (RTW over the paraboloid) is subdivided again for the warp (the RTW
+    /// rule measured on the side's warped projection) and its vertices warped.
     fn rasterize_paraboloid(
         &self,
         map: &shadowmap::paraboloid::ParaboloidMap,
+        warps: [Option<&WarpMaps>; 2],
         mesh: &Mesh,
         options: &RasterOptions,
     ) -> Result<DepthMap, EvalError> {
@@ -442,7 +469,16 @@ impl Technique {
                 inner: ParaboloidProjector::from(map),
                 layer,
             };
-            let d = rasterize_depth(&mesh_of(&pieces), &one, options)?;
+            let d = if let Some(warps) = warps.get(layer as usize).copied().flatten() {
+                let uv = |p: Vec3| map.project(p, which).map(|s| s.uv);
+                let rtw = RtwSubdivision::default().with_resolution(side);
+                let mut warped = Vec::new();
+                subdivide_for_rtw_with(uv, warps, &pieces, &rtw, &mut warped);
+                let inner = WarpedProjector { inner: one, warps };
+                rasterize_depth(&mesh_of(&warped), &inner, options)?
+            } else {
+                rasterize_depth(&mesh_of(&pieces), &one, options)?
+            };
             let at = layer as usize * per_layer;
             out.depth[at..at + per_layer].copy_from_slice(&d.depth);
         }

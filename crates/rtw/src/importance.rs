@@ -32,12 +32,16 @@ pub struct EyeSample {
 ///
 /// ```text
 /// importance = (reference_distance / max(d, min_distance))^distance_exponent
+///            * w                                              (backward)
 ///            * (1 + orientation_weight * (1 - |n . l|))      (backward, normal given)
 ///            * edge_weight                                    (backward, on an edge)
 /// ```
 ///
-/// with `d` the eye distance (backward) or view depth (forward), `n` the unit normal
-/// and `l` the unit direction toward the light.
+/// with `d` the eye distance (backward) or view depth (forward), `n` the unit normal,
+/// `l` the unit direction toward the light and `w` the sample's homogeneous `w` in the
+/// base projection: 1 for an orthographic base, the light depth for a perspective
+/// one (a spot fit), whose texels grow with the distance from the light, so the
+/// importance stays the texel density the sample needs in the base's `uv`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[non_exhaustive]
@@ -138,6 +142,31 @@ pub struct AccumulateStats {
     /// Samples that fell outside the base map (or behind a perspective light, or
     /// outside the eye's view in forward analysis), skipped.
     pub skipped: usize,
+}
+
+/// Where a world point falls in the base map of an importance map, for
+/// [`ImportanceMap::accumulate_backward_with`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BasePoint {
+    /// Base texture coordinates.
+    pub uv: DVec2,
+    /// World extent of one unit of base `uv` at the point, across the light's ray (any
+    /// constant factor: the warp normalizes): 1 for an orthographic base, the light
+    /// depth for a perspective one, `distance / sqrt(uv² per steradian)` in general.
+    /// Positive and finite, else the sample is skipped.
+    pub footprint: f64,
+    /// Direction toward the light (need not be unit length), for the orientation
+    /// term.
+    pub toward_light: DVec3,
+}
+
+impl BasePoint {
+    fn is_valid(&self) -> bool {
+        self.uv.is_finite()
+            && self.footprint.is_finite()
+            && self.footprint > 0.0
+            && self.toward_light.is_finite()
+    }
 }
 
 /// The base projection, checked and prepared once per accumulation.
@@ -338,6 +367,39 @@ impl ImportanceMap {
     ) -> Result<AccumulateStats, RtwError> {
         options.validate()?;
         let base = Base::new(base)?;
+        // Texels per unit of base `uv` the sample needs: its texels per world unit
+        // times the world extent of one unit of base `uv`, which is constant for an
+        // orthographic base (`w = 1`) and grows as `w` (the light depth) for a
+        // perspective one.
+        let project = |p: DVec3| {
+            let (uv, h) = base.project(p)?;
+            Some(BasePoint {
+                uv,
+                footprint: h.w,
+                toward_light: base.toward_light(p),
+            })
+        };
+        self.accumulate_backward_with(project, samples, edge_mask, options)
+    }
+
+    /// Backward analysis over any base mapping (a paraboloid side, a cube face, ...):
+    /// `project` says where a world point falls in this map's base ([`BasePoint`]),
+    /// `None` where the base does not store it. The importance of a sample is that of
+    /// [`ImportanceOptions`] times the base's footprint there, so it is the density
+    /// the sample needs in base `uv` whatever the base's own texel distribution.
+    /// [`accumulate_backward`](Self::accumulate_backward) is this over a matrix base.
+    ///
+    /// # Errors
+    /// As [`accumulate_backward`](Self::accumulate_backward) (a non-finite
+    /// [`BasePoint`] is skipped, not an error).
+    pub fn accumulate_backward_with(
+        &mut self,
+        project: impl Fn(DVec3) -> Option<BasePoint>,
+        samples: &[EyeSample],
+        edge_mask: Option<&[bool]>,
+        options: &ImportanceOptions,
+    ) -> Result<AccumulateStats, RtwError> {
+        options.validate()?;
         if let Some(mask) = edge_mask {
             if mask.len() != samples.len() {
                 return Err(RtwError::SizeMismatch {
@@ -350,20 +412,20 @@ impl ImportanceMap {
         let mut stats = AccumulateStats::default();
         for (i, s) in samples.iter().enumerate() {
             let p = s.position.as_dvec3();
-            let Some((uv, _)) = base.project(p) else {
+            let Some(b) = project(p).filter(BasePoint::is_valid) else {
                 stats.skipped += 1;
                 continue;
             };
-            let mut imp = options.distance_term(f64::from(s.eye_distance));
+            let mut imp = options.distance_term(f64::from(s.eye_distance)) * b.footprint;
             let n = s.normal.as_dvec3().normalize_or_zero();
             if n != DVec3::ZERO {
-                let cos = n.dot(base.toward_light(p)).abs().min(1.0);
+                let cos = n.dot(b.toward_light.normalize_or_zero()).abs().min(1.0);
                 imp *= 1.0 + f64::from(options.orientation_weight) * (1.0 - cos);
             }
             if edge_mask.is_some_and(|m| m.get(i).copied().unwrap_or(false)) {
                 imp *= f64::from(options.edge_weight);
             }
-            if self.splat_f64(uv, imp) {
+            if self.splat_f64(b.uv, imp) {
                 stats.accepted += 1;
             } else {
                 stats.skipped += 1;

@@ -147,10 +147,10 @@ mod warp;
 
 pub use error::RtwError;
 pub use importance::{
-    AccumulateStats, EyeSample, ImportanceMap, ImportanceOptions, MAX_MAP_CELLS, MAX_MAP_SIDE,
-    OracleAxis,
+    AccumulateStats, BasePoint, EyeSample, ImportanceMap, ImportanceOptions, MAX_MAP_CELLS,
+    MAX_MAP_SIDE, OracleAxis,
 };
-pub use subdivide::{RtwSubdivision, subdivide_for_rtw};
+pub use subdivide::{RtwSubdivision, subdivide_for_rtw, subdivide_for_rtw_with};
 pub use table::{
     forward_warp, forward_warp_f64, inverse_warp, inverse_warp_f64, sample_table, sample_table_f64,
 };

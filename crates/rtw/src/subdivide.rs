@@ -14,7 +14,7 @@ use alloc::vec::Vec;
 
 use glam::{DVec2, Vec3};
 
-use crate::{RtwShadow, forward_warp_f64};
+use crate::{RtwShadow, WarpMaps, forward_warp_f64};
 
 /// How finely [`subdivide_for_rtw`] splits casters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -104,6 +104,22 @@ pub fn subdivide_for_rtw(
     options: &RtwSubdivision,
     out: &mut Vec<[Vec3; 3]>,
 ) -> usize {
+    let base = |p: Vec3| shadow.base.project(p).map(|s| s.uv);
+    subdivide_for_rtw_with(base, shadow.warps, triangles, options, out)
+}
+
+/// [`subdivide_for_rtw`] over any base mapping: `base_uv` gives a world point's
+/// texture coordinates in the base map (one paraboloid side, one cube face, ...),
+/// `None` where it cannot map it; `warps` are that map's tables. The split rule
+/// measures the warped image of the base, so it also follows a curved base (a
+/// paraboloid) as far as the pieces and the error bound allow.
+pub fn subdivide_for_rtw_with(
+    base_uv: impl Fn(Vec3) -> Option<DVec2>,
+    warps: &WarpMaps,
+    triangles: &[[Vec3; 3]],
+    options: &RtwSubdivision,
+    out: &mut Vec<[Vec3; 3]>,
+) -> usize {
     out.clear();
     let defaults = RtwSubdivision::default();
     let at_least = |x: f64, default: f64| {
@@ -116,11 +132,9 @@ pub fn subdivide_for_rtw(
     let max_span = at_least(options.max_span_cells, defaults.max_span_cells);
     let max_error = at_least(options.max_error_texels, defaults.max_error_texels);
     let splitter = RtwSplitter {
-        shadow,
-        pieces: DVec2::new(
-            shadow.warps.x_table().len() as f64,
-            shadow.warps.y_table().len() as f64,
-        ) / max_span,
+        base_uv,
+        warps,
+        pieces: DVec2::new(warps.x_table().len() as f64, warps.y_table().len() as f64) / max_span,
         error_scale: f64::from(options.resolution.max(1)) / max_error,
     };
     let levels = options
@@ -139,8 +153,9 @@ pub fn subdivide_for_rtw(
 }
 
 /// The per-edge split rule of [`subdivide_for_rtw`].
-struct RtwSplitter<'a, 'b> {
-    shadow: &'a RtwShadow<'b>,
+struct RtwSplitter<'a, F> {
+    base_uv: F,
+    warps: &'a WarpMaps,
     /// Pieces per unit of base texture space along `u` and `v` (table texels over
     /// the longest piece in cells).
     pieces: DVec2,
@@ -148,19 +163,15 @@ struct RtwSplitter<'a, 'b> {
     error_scale: f64,
 }
 
-impl RtwSplitter<'_, '_> {
+impl<F: Fn(Vec3) -> Option<DVec2>> RtwSplitter<'_, F> {
     fn uv(&self, p: Vec3) -> Option<DVec2> {
-        self.shadow
-            .base
-            .project(p)
-            .map(|s| s.uv)
-            .filter(|uv| uv.is_finite())
+        (self.base_uv)(p).filter(|uv| uv.is_finite())
     }
 
     fn warp(&self, uv: DVec2) -> DVec2 {
         DVec2::new(
-            forward_warp_f64(self.shadow.warps.x_table(), uv.x),
-            forward_warp_f64(self.shadow.warps.y_table(), uv.y),
+            forward_warp_f64(self.warps.x_table(), uv.x),
+            forward_warp_f64(self.warps.y_table(), uv.y),
         )
     }
 

@@ -558,12 +558,22 @@ pub struct RtwShadow<'a> {
 
 impl ShadowMapping for RtwShadow<'_> {
     fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
-        let s = self.base.map_point(world)?;
+        self.warps.warp_sample(self.base.map_point(world)?)
+    }
+}
+
+impl WarpMaps {
+    /// A base map's sample with its `uv` warped by these tables (in `f64`, the
+    /// function the shader evaluates in `f32`); depth and layer unchanged. `None` for
+    /// a non-finite result. Any base mapping (a matrix, a paraboloid side) is warped
+    /// this way.
+    #[must_use]
+    pub fn warp_sample(&self, sample: ShadowSample) -> Option<ShadowSample> {
         let uv = glam::DVec2::new(
-            forward_warp_f64(&self.warps.x, s.uv.x),
-            forward_warp_f64(&self.warps.y, s.uv.y),
+            forward_warp_f64(&self.x, sample.uv.x),
+            forward_warp_f64(&self.y, sample.uv.y),
         );
-        uv.is_finite().then_some(ShadowSample { uv, ..s })
+        uv.is_finite().then_some(ShadowSample { uv, ..sample })
     }
 }
 

@@ -24,6 +24,8 @@ pub mod cube;
 pub mod frustum;
 #[cfg(feature = "paraboloid")]
 pub mod paraboloid;
+#[cfg(all(feature = "paraboloid", feature = "rtw"))]
+pub mod point_rtw;
 #[cfg(feature = "rtw")]
 pub mod rtw;
 #[cfg(feature = "serde")]

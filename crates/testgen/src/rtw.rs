@@ -5,18 +5,18 @@
 //! the typed error the input calls for; never a panic.
 
 use arbitrary::Unstructured;
-use glam::{Mat4, Vec3};
+use glam::{DVec2, Mat4, Vec3};
 use shadowmap_frustum::{
-    Camera, CascadeFit, CascadeOptions, LightDirection, ShadowTransform,
-    directional_light_from_world, fit_cascade, projection,
+    Camera, CascadeFit, CascadeOptions, Light, LightDirection, SceneBounds, ShadowMapping,
+    ShadowTransform, directional_light_from_world, fit_cascade, fit_spot, projection,
 };
 use shadowmap_rtw::{
-    EyeSample, ImportanceMap, ImportanceOptions, MAX_BLUR_RADIUS, MIN_FLOOR, RtwError, WarpMaps,
-    WarpOptions, forward_warp, forward_warp_f64, inverse_warp_f64,
+    EyeSample, ImportanceMap, ImportanceOptions, MAX_BLUR_RADIUS, MIN_FLOOR, RtwError, RtwShadow,
+    WarpMaps, WarpOptions, forward_warp, forward_warp_f64, inverse_warp_f64,
 };
 
 use crate::{
-    GenResult, any_f32, any_vec3, camera, in_range, light_direction, log_uniform, unit_vec3,
+    GenResult, aabb, any_f32, any_vec3, camera, in_range, light_direction, log_uniform, unit_vec3,
 };
 
 /// Input of [`check_warp`]: an importance map given as raw values, and the options
@@ -354,25 +354,18 @@ fn fallback_base() -> ShadowTransform {
     )
 }
 
-/// A valid accumulation case: a generated camera, a light, the tight uniform fit of
-/// its whole range as the base, and samples inside the frustum.
-pub fn accumulate_case(u: &mut Unstructured<'_>) -> GenResult<AccumulateCase> {
-    let camera = camera(u)?;
-    let light = light_direction(u, &camera)?;
-    let base = camera
-        .depth_range()
-        .and_then(|(n, f)| {
-            let opts = CascadeOptions::default().with_fit(CascadeFit::Tight);
-            fit_cascade(&camera, light, n, f, &opts)
-        })
-        .map_or_else(|_| fallback_base(), |c| c.transform);
-    let size = (u.int_in_range(1u32..=48)?, u.int_in_range(1u32..=48)?);
+/// `count` eye samples inside the camera's frustum (a quarter with no normal), with
+/// their true eye distances.
+pub(crate) fn frustum_samples(
+    u: &mut Unstructured<'_>,
+    camera: &Camera,
+    count: usize,
+) -> GenResult<Vec<EyeSample>> {
     let corners = camera
         .frustum()
         .map(|f| f.corners)
         .unwrap_or([Vec3::ZERO; 8]);
     let eye = camera.eye();
-    let count = u.int_in_range(0usize..=64)?;
     let mut samples = Vec::with_capacity(count);
     for _ in 0..count {
         let (a, b, c) = (
@@ -403,6 +396,29 @@ pub fn accumulate_case(u: &mut Unstructured<'_>) -> GenResult<AccumulateCase> {
             eye_distance: position.distance(eye),
         });
     }
+    Ok(samples)
+}
+
+/// A valid accumulation case: a generated camera, a light, the tight uniform fit of
+/// its whole range as the base, and samples inside the frustum.
+pub fn accumulate_case(u: &mut Unstructured<'_>) -> GenResult<AccumulateCase> {
+    let camera = camera(u)?;
+    accumulate_case_for(u, camera)
+}
+
+/// [`accumulate_case`] for a given camera.
+fn accumulate_case_for(u: &mut Unstructured<'_>, camera: Camera) -> GenResult<AccumulateCase> {
+    let light = light_direction(u, &camera)?;
+    let base = camera
+        .depth_range()
+        .and_then(|(n, f)| {
+            let opts = CascadeOptions::default().with_fit(CascadeFit::Tight);
+            fit_cascade(&camera, light, n, f, &opts)
+        })
+        .map_or_else(|_| fallback_base(), |c| c.transform);
+    let size = (u.int_in_range(1u32..=48)?, u.int_in_range(1u32..=48)?);
+    let count = u.int_in_range(0usize..=64)?;
+    let samples = frustum_samples(u, &camera, count)?;
     let edge_mask = if u.arbitrary()? {
         Some((0..count).map(|_| u.arbitrary().unwrap_or(false)).collect())
     } else {
@@ -580,4 +596,137 @@ pub fn check_accumulate(case: &AccumulateCase) {
     let options = WarpOptions::default();
     warps.build(&map, &options).expect("valid options");
     check_built(&warps, &map, &options);
+}
+
+/// Input of [`check_spot_rtw`]: RTW over the spot fit (a perspective base).
+#[derive(Clone, Debug)]
+pub struct SpotRtwCase {
+    /// Camera, samples, map size and options; its base is replaced by the spot fit.
+    pub accumulate: AccumulateCase,
+    /// The light (raw cases: any spot, or not a spot).
+    pub light: Light,
+    /// Receiver and caster bounds, if any.
+    pub scene: Option<SceneBounds>,
+    /// Warp options.
+    pub warp: WarpOptions,
+}
+
+/// A spot light around a point the camera looks at, at any distance from it, mostly
+/// aimed at it, sometimes back at the viewer (dueling frusta) or anywhere; half-angle
+/// up to 86 degrees; sometimes non-finite or not a spot (raw).
+pub fn spot_rtw_case_raw(u: &mut Unstructured<'_>) -> GenResult<SpotRtwCase> {
+    // The light first: the samples take what is left of the input.
+    let camera = &camera(u)?;
+    let (near, far) = camera.depth_range().unwrap_or((0.1, 100.0));
+    let scale = far.min(1e3).max(near);
+    let target = camera.eye() + camera.forward() * in_range(u, near, scale)?;
+    let distance = log_uniform(u, 1e-3 * scale, 2.0 * scale)?;
+    let position = target + unit_vec3(u)? * distance;
+    let direction = match u.int_in_range(0u8..=4)? {
+        0 => -camera.forward(),
+        1 => unit_vec3(u)?,
+        _ => (target - position).normalize_or(Vec3::NEG_Y),
+    };
+    let light = match u.int_in_range(0u8..=7)? {
+        0 => Light::Spot {
+            position: any_vec3(u)?,
+            direction: any_vec3(u)?,
+            half_angle: any_f32(u)?,
+            range: any_f32(u)?,
+        },
+        1 => Light::Point {
+            position,
+            range: scale,
+        },
+        _ => Light::Spot {
+            position,
+            direction,
+            half_angle: in_range(u, 1e-3, 1.5)?,
+            range: distance * log_uniform(u, 0.5, 1e3)?,
+        },
+    };
+    let scene = if u.int_in_range(0u8..=3)? == 0 {
+        Some(SceneBounds {
+            receivers: aabb(u, scale)?,
+            casters: aabb(u, scale)?,
+        })
+    } else {
+        None
+    };
+    let warp = warp_options(u)?;
+    Ok(SpotRtwCase {
+        accumulate: accumulate_case_for(u, *camera)?,
+        light,
+        scene,
+        warp,
+    })
+}
+
+/// RTW over the spot fit, where the spot fit succeeds: accumulation on the
+/// perspective base keeps the contract of [`check_accumulate`]; every sample the spot
+/// fit maps into its map is mapped into the map by RTW too (coverage), with the base's
+/// depth, a finite `uv` that the inverse warp takes back, and the order of the base
+/// `u` and `v` kept (monotone warp). Returns how many samples were checked that way.
+pub fn check_spot_rtw(case: &SpotRtwCase) -> usize {
+    let Ok(frustum) = case.accumulate.camera.frustum() else {
+        return 0;
+    };
+    let Ok(spot) = fit_spot(&case.light, &frustum, case.scene.as_ref(), false) else {
+        return 0;
+    };
+    let accumulate = AccumulateCase {
+        base: spot.transform,
+        ..case.accumulate.clone()
+    };
+    check_accumulate(&accumulate);
+    let (w, h) = accumulate.size;
+    let mut map = ImportanceMap::new(w, h).expect("generated sizes are valid");
+    map.accumulate_backward(
+        &spot.transform,
+        &accumulate.samples,
+        None,
+        &accumulate.options,
+    )
+    .expect("valid samples and options");
+    let mut warps = WarpMaps::new(w, h).expect("valid size");
+    warps.build(&map, &case.warp).expect("valid options");
+    check_built(&warps, &map, &case.warp);
+    let rtw = RtwShadow {
+        base: spot.transform,
+        warps: &warps,
+    };
+    let mut mapped: Vec<(DVec2, DVec2)> = Vec::new();
+    for s in &accumulate.samples {
+        let p = s.position.as_dvec3();
+        let Some(b) = spot.transform.map_point(p) else {
+            continue;
+        };
+        let inside = |uv: DVec2| uv.cmpge(DVec2::ZERO).all() && uv.cmple(DVec2::ONE).all();
+        if !inside(b.uv) {
+            continue;
+        }
+        let r = rtw
+            .map_point(p)
+            .expect("inside the base map, mapped by RTW");
+        assert!(r.uv.is_finite() && inside(r.uv), "{:?} left the map", r.uv);
+        assert_eq!(r.depth, b.depth, "RTW changed the base depth");
+        let back = warps.unwarp_uv(r.uv.as_vec2()).as_dvec2();
+        assert!(
+            (back - b.uv).abs().max_element() < 1e-4,
+            "{back} vs {}",
+            b.uv
+        );
+        mapped.push((b.uv, r.uv));
+    }
+    for (a, b) in mapped
+        .iter()
+        .flat_map(|a| mapped.iter().map(move |b| (a, b)))
+    {
+        for axis in 0..2 {
+            if a.0[axis] < b.0[axis] {
+                assert!(a.1[axis] <= b.1[axis] + 1e-12, "warp not monotone");
+            }
+        }
+    }
+    mapped.len()
 }

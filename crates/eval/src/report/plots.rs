@@ -82,7 +82,7 @@ fn err(e: impl std::fmt::Display) -> String {
 }
 
 /// One colour per technique of [`TechniqueKind::ALL`], distinct on white.
-const TECHNIQUE_COLOURS: [RGBColor; 14] = [
+const TECHNIQUE_COLOURS: [RGBColor; 18] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -97,6 +97,10 @@ const TECHNIQUE_COLOURS: [RGBColor; 14] = [
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(140, 86, 75),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
 ];
 
 /// The colour of a technique (its position in [`TechniqueKind::ALL`]; the point

@@ -37,7 +37,7 @@ fn every_light_has_techniques() {
         range: 10.0,
     };
     assert_eq!(TechniqueKind::for_light(&d).len(), 10);
-    assert_eq!(TechniqueKind::for_light(&p).len(), 5);
+    assert_eq!(TechniqueKind::for_light(&p).len(), 6);
     assert!(!TechniqueKind::SpotFit.applies_to(&d));
 }
 

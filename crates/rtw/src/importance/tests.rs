@@ -166,3 +166,50 @@ fn singular_min_is_right() {
     assert!((s - 2.0).abs() < 1e-12);
     assert!(singular_min(1.0, 1.0, 1.0, 1.0).is_none());
 }
+
+#[test]
+fn backward_importance_over_a_perspective_base_grows_with_the_light_depth() {
+    // A spot at the origin looking down -Z, 90 degrees wide: the base texel at light
+    // depth z spans z times the world extent it spans at depth 1, so a sample there
+    // needs z times the texels per unit of base uv.
+    let light = Mat4::IDENTITY;
+    let clip = shadowmap_frustum::projection::perspective(
+        core::f64::consts::FRAC_PI_2,
+        1.0,
+        0.5,
+        100.0,
+        false,
+    )
+    .as_mat4();
+    let base = ShadowTransform::new(light, clip, false, LightDirection::Position(Vec3::ZERO));
+    let mut m = ImportanceMap::new(8, 8).unwrap();
+    let sample = |position: Vec3| EyeSample {
+        position,
+        normal: Vec3::ZERO,
+        eye_distance: 5.0,
+    };
+    // Same eye distance, light depths 2 and 20, in different cells.
+    let samples = [
+        sample(Vec3::new(-1.5, 0.0, -2.0)),
+        sample(Vec3::new(15.0, 0.0, -20.0)),
+    ];
+    let stats = m
+        .accumulate_backward(&base, &samples, None, &ImportanceOptions::default())
+        .unwrap();
+    assert_eq!(stats.accepted, 2);
+    let mut cells: Vec<f32> = m.as_slice().iter().copied().filter(|c| *c > 0.0).collect();
+    cells.sort_by(f32::total_cmp);
+    assert_eq!(cells.len(), 2);
+    assert!((cells[0] - 2.0 / 5.0).abs() < 1e-5, "{cells:?}");
+    assert!((cells[1] - 20.0 / 5.0).abs() < 1e-4, "{cells:?}");
+    // An orthographic base (w = 1) keeps the plain distance term.
+    let mut flat = ImportanceMap::new(4, 4).unwrap();
+    flat.accumulate_backward(
+        &identity_base(),
+        &[sample(Vec3::new(0.5, 0.5, 0.0))],
+        None,
+        &ImportanceOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(flat.get(2, 2), Some(1.0 / 5.0));
+}
