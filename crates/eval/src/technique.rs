@@ -445,8 +445,8 @@ impl Technique {
     }
 
     /// Each side of a paraboloid map from its subdivided mesh; a side with warp
-    /// tables (RTW over the paraboloid) is subdivided again for the warp (the RTW
-    /// rule measured on the side's warped projection) and its vertices warped.
+    /// tables (RTW over the paraboloid) is subdivided by the RTW rule measured on the
+    /// side's warped projection instead, and its vertices warped.
     fn rasterize_paraboloid(
         &self,
         map: &shadowmap::paraboloid::ParaboloidMap,
@@ -463,20 +463,23 @@ impl Technique {
         let mut pieces = Vec::new();
         for layer in 0..layers {
             let which = if layer == 0 { Side::Front } else { Side::Back };
-            subdivide_triangles(map, which, &triangles, &sub, &mut pieces)
-                .map_err(|x| fail(self.kind, &x))?;
             let one = OneLayer {
                 inner: ParaboloidProjector::from(map),
                 layer,
             };
             let d = if let Some(warps) = warps.get(layer as usize).copied().flatten() {
+                // One pass of the RTW rule over the casters: it measures the warped
+                // image of the curved side, so it follows the paraboloid's curvature
+                // and the warp together (subdividing the paraboloid's pieces again
+                // would multiply the two limits: up to 16² x 32² pieces a caster).
                 let uv = |p: Vec3| map.project(p, which).map(|s| s.uv);
                 let rtw = RtwSubdivision::default().with_resolution(side);
-                let mut warped = Vec::new();
-                subdivide_for_rtw_with(uv, warps, &pieces, &rtw, &mut warped);
+                subdivide_for_rtw_with(uv, warps, &triangles, &rtw, &mut pieces);
                 let inner = WarpedProjector { inner: one, warps };
-                rasterize_depth(&mesh_of(&warped), &inner, options)?
+                rasterize_depth(&mesh_of(&pieces), &inner, options)?
             } else {
+                subdivide_triangles(map, which, &triangles, &sub, &mut pieces)
+                    .map_err(|x| fail(self.kind, &x))?;
                 rasterize_depth(&mesh_of(&pieces), &one, options)?
             };
             let at = layer as usize * per_layer;
