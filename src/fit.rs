@@ -6,8 +6,9 @@ use core::fmt;
 use glam::Vec3;
 use shadowmap_frustum::math::{floor, powf, sqrt};
 use shadowmap_frustum::{
-    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, FrustumError,
-    Light, MAX_CASCADES, SceneBounds, SplitScheme, TechniqueSelector, fit_spot,
+    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, DepthBounds,
+    FrustumError, Light, MAX_CASCADES, SceneBounds, SplitScheme, TechniqueSelector, ValidCamera,
+    fit_spot,
 };
 use shadowmap_paraboloid::{IpsmPlan, ParaboloidError, ParaboloidMap};
 use shadowmap_rtw::{EyeSample, ImportanceMap, OracleAxis, RtwError, WarpMaps};
@@ -192,7 +193,8 @@ pub fn fit(technique: &Technique, input: &FitInput<'_>) -> Result<Shadow, FitErr
 
 /// [`fit`], with the caller's `selector` keeping `auto`'s choice across frames
 /// (hysteresis: it switches only when another candidate is predicted better by the
-/// selector's margin). Other techniques ignore the selector.
+/// selector's margin). Other techniques ignore the selector; stable cascades start
+/// from a fresh [`CascadeState`] (use [`fit_with_state`] to keep their sizes).
 ///
 /// # Errors
 /// As [`fit`].
@@ -200,6 +202,44 @@ pub fn fit_with_selector(
     technique: &Technique,
     input: &FitInput<'_>,
     selector: &mut TechniqueSelector,
+) -> Result<Shadow, FitError> {
+    fit_stateful(technique, input, selector, &mut CascadeState::new())
+}
+
+/// What a renderer keeps from one frame to the next for one light and view:
+/// `auto`'s choice and the stable cascades' held sizes and count. Start with
+/// `FitState::default()` and pass the same value to [`fit_with_state`] every frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FitState {
+    /// `auto`'s current choice, kept with hysteresis.
+    pub selector: TechniqueSelector,
+    /// The stable cascades' sizes (and the cascaded techniques' count), kept with
+    /// hysteresis.
+    pub cascades: CascadeState,
+}
+
+/// [`fit`], with the caller-held `state` threaded through the frames: `auto` keeps
+/// its choice ([`TechniqueSelector`]), the stable cascades keep each map's size while
+/// it still covers slice ∩ receivers and is not too big (so the maps move by whole
+/// texels and do not shimmer), and the cascaded techniques keep their count unless
+/// another count is clearly better. Other techniques ignore the state.
+///
+/// # Errors
+/// As [`fit`].
+pub fn fit_with_state(
+    technique: &Technique,
+    input: &FitInput<'_>,
+    state: &mut FitState,
+) -> Result<Shadow, FitError> {
+    fit_stateful(technique, input, &mut state.selector, &mut state.cascades)
+}
+
+/// [`fit_with_state`] with its two parts of the state apart.
+pub(crate) fn fit_stateful(
+    technique: &Technique,
+    input: &FitInput<'_>,
+    selector: &mut TechniqueSelector,
+    cascades: &mut CascadeState,
 ) -> Result<Shadow, FitError> {
     if !technique.applies_to(input.light) {
         return Err(FitError::WrongLight {
@@ -210,9 +250,9 @@ pub fn fit_with_selector(
         return Err(FitError::InvalidBudget);
     }
     if let Technique::Auto(plan) = technique {
-        return crate::auto::fit_auto(plan, input, selector);
+        return crate::auto::fit_auto(plan, input, selector, cascades);
     }
-    let (fitted, layers) = fit_one(technique, input)?;
+    let (fitted, layers) = fit_one(technique, input, cascades)?;
     Ok(Shadow {
         requested: *technique,
         technique: *technique,
@@ -223,7 +263,11 @@ pub fn fit_with_selector(
 }
 
 /// The result and layer count of every technique but `auto`.
-fn fit_one(technique: &Technique, input: &FitInput<'_>) -> Result<(Fitted, u32), FitError> {
+fn fit_one(
+    technique: &Technique,
+    input: &FitInput<'_>,
+    state: &mut CascadeState,
+) -> Result<(Fitted, u32), FitError> {
     let (camera, scene) = (input.camera, &input.scene);
     let direction = match *input.light {
         Light::Directional { direction } => direction,
@@ -239,9 +283,11 @@ fn fit_one(technique: &Technique, input: &FitInput<'_>) -> Result<(Fitted, u32),
         Technique::Tsm(o) => (Fitted::Tsm(tsm(camera, direction, scene, o)?), 1),
         Technique::StableCascades(plan) | Technique::TightCascades(plan) => {
             let stable = matches!(technique, Technique::StableCascades(_));
-            fit_cascades(plan, stable, direction, input)?
+            fit_cascades(plan, stable, direction, input, state)?
         }
-        Technique::WarpedCascades { plan, lispsm } => fit_warped(plan, lispsm, direction, input)?,
+        Technique::WarpedCascades { plan, lispsm } => {
+            fit_warped(plan, lispsm, direction, input, state)?
+        }
         Technique::Rtw(plan) => (fit_rtw(plan, false, direction, input)?, 1),
         Technique::RtwOracle(plan) => (fit_rtw(plan, true, direction, input)?, 1),
         Technique::SpotFit { reversed_z } => {
@@ -260,27 +306,26 @@ fn fit_one(technique: &Technique, input: &FitInput<'_>) -> Result<(Fitted, u32),
     })
 }
 
-/// Ladder step of the stable cascades' sizes: a rung every half octave.
-const STABLE_SIZE_STEP: f32 = core::f32::consts::SQRT_2;
-
 fn fit_cascades(
     plan: &CascadePlan,
     stable: bool,
     direction: Vec3,
     input: &FitInput<'_>,
+    state: &mut CascadeState,
 ) -> Result<(Fitted, u32), FitError> {
-    let splits = cascade_splits(plan, input)?;
+    let splits = cascade_splits(plan, input, state)?;
     let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
     let fit = CascadeOptions::default()
         .with_resolution(input.layer_side(layers))
         .with_reversed_z(plan.reversed_z)
-        .with_scene(Some(input.scene));
-    let fit = if stable {
-        fit.with_stable_size_step(Some(STABLE_SIZE_STEP))
-    } else {
-        fit.with_fit(CascadeFit::Tight)
-    };
-    let set = CascadeSet::fit(input.camera, direction, &splits, &fit)?;
+        .with_scene(Some(input.scene))
+        .with_fit(if stable {
+            CascadeFit::Stable
+        } else {
+            CascadeFit::Tight
+        });
+    let camera = ValidCamera::new(input.camera)?;
+    let set = CascadeSet::fit_with_state(&camera, direction, &splits, &fit, state)?;
     Ok((Fitted::Cascades(set), layers))
 }
 
@@ -289,10 +334,11 @@ fn fit_warped(
     options: &LispsmOptions,
     direction: Vec3,
     input: &FitInput<'_>,
+    state: &mut CascadeState,
 ) -> Result<(Fitted, u32), FitError> {
     // The same split rule as the unwarped cascades: count and range from the depth
     // bounds, so no cascade is spent on empty depth.
-    let splits = cascade_splits(plan, input)?;
+    let splits = cascade_splits(plan, input, state)?;
     let count = splits.count();
     let etas = [options.eta; MAX_CASCADES];
     let cascades = warped_cascades(
@@ -311,14 +357,25 @@ fn fit_warped(
     Ok((fitted, u32::try_from(count).unwrap_or(u32::MAX)))
 }
 
+/// A count kept from the previous frame stays while its cost is within this factor
+/// of the best count's (see [`cascade_splits`]).
+const COUNT_KEEP_RATIO: f64 = 1.1;
+
 /// Splits of the cascaded techniques: practical splits of the depth bounds (the
 /// camera's range without them), so no cascade covers empty depth. The count follows
 /// the bounds' ratio `r = max / min`: with `k` maps sharing the budget, a
 /// logarithmic split leaves each cascade a depth ratio `r^(1/k)` on `side(k)` texels,
 /// so the count minimizing `r^(1/k) / side(k)` is taken, among the counts up to
 /// `plan.max_cascades` whose side is a power of two when there are any (the stable
-/// fit's whole-texel motion is exact in `f32` only there).
-fn cascade_splits(plan: &CascadePlan, input: &FitInput<'_>) -> Result<CascadeSplits, FitError> {
+/// fit's whole-texel motion is exact in `f32` only there). The count of the previous
+/// frame (held in `state`) is kept while its cost is within [`COUNT_KEEP_RATIO`] of
+/// the best, so a depth range near the boundary between two counts does not
+/// re-size every map from one frame to the next.
+fn cascade_splits(
+    plan: &CascadePlan,
+    input: &FitInput<'_>,
+    state: &mut CascadeState,
+) -> Result<CascadeSplits, FitError> {
     let camera = input.camera;
     let (near, far) = match input.depth_bounds {
         Some(bounds) => bounds.clamped_to(camera)?,
@@ -328,11 +385,19 @@ fn cascade_splits(plan: &CascadePlan, input: &FitInput<'_>) -> Result<CascadeSpl
     let max = plan.max_cascades.clamp(1, MAX_CASCADES);
     let side = |k: usize| input.layer_side(u32::try_from(k).unwrap_or(u32::MAX));
     let any_power = (1..=max).any(|k| side(k).is_power_of_two());
+    let allowed = |k: usize| (1..=max).contains(&k) && (!any_power || side(k).is_power_of_two());
     let cost = |k: usize| powf(ratio, 1.0 / k as f64) / f64::from(side(k));
-    let count = (1..=max)
-        .filter(|k| !any_power || side(*k).is_power_of_two())
+    let best = (1..=max)
+        .filter(|k| allowed(*k))
         .min_by(|a, b| cost(*a).total_cmp(&cost(*b)))
         .unwrap_or(1);
+    let kept = state.count();
+    let count = if allowed(kept) && cost(kept) <= cost(best) * COUNT_KEEP_RATIO {
+        kept
+    } else {
+        best
+    };
+    state.set_count(count);
     let scheme = SplitScheme::Practical {
         lambda: plan.split_lambda,
     };

@@ -122,7 +122,10 @@ mod technique;
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 pub use auto::{AUTO_CANDIDATE_COUNT, auto_candidates};
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
-pub use fit::{FitError, FitInput, depth_bounds_of, fit, fit_with_selector, layer_side};
+pub use fit::{
+    FitError, FitInput, FitState, depth_bounds_of, fit, fit_with_selector, fit_with_state,
+    layer_side,
+};
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 pub use shadow::{Fitted, Shadow};
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]

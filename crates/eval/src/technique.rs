@@ -23,7 +23,9 @@
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap::paraboloid::{ConeFit, IpsmOptions, Side, SubdivisionOptions, subdivide_triangles};
 use shadowmap::rtw::{EyeSample, RtwSubdivision, subdivide_for_rtw};
-use shadowmap::{CascadePlan, FitInput, Fitted, RtwPlan, Shadow, depth_bounds_of, fit};
+use shadowmap::{
+    CascadePlan, FitInput, FitState, Fitted, RtwPlan, Shadow, depth_bounds_of, fit_with_state,
+};
 use shadowmap_frustum::{Camera, Light, SceneBounds, ShadowMapping, ShadowSample};
 
 use crate::EvalError;
@@ -285,7 +287,7 @@ fn fail(kind: TechniqueKind, reason: &dyn core::fmt::Display) -> EvalError {
 }
 
 impl Technique {
-    /// Fits `kind` to a frame with [`shadowmap::fit`] (eye samples, their depth
+    /// Fits `kind` to a single frame with [`shadowmap::fit`] (eye samples, their depth
     /// bounds and the image's focal length as the optional inputs).
     ///
     /// # Errors
@@ -296,11 +298,27 @@ impl Technique {
         frame: &FrameContext<'_>,
         options: &TechniqueOptions,
     ) -> Result<Self, EvalError> {
+        Self::build_with_state(kind, frame, options, &mut FitState::default())
+    }
+
+    /// As [`Technique::build`], for one frame of a sequence: `state` carries what a
+    /// renderer keeps from frame to frame ([`shadowmap::fit_with_state`]: `auto`'s
+    /// choice, the stable cascades' held sizes, the cascade count).
+    ///
+    /// # Errors
+    /// As [`Technique::build`].
+    pub fn build_with_state(
+        kind: TechniqueKind,
+        frame: &FrameContext<'_>,
+        options: &TechniqueOptions,
+        state: &mut FitState,
+    ) -> Result<Self, EvalError> {
         let input = FitInput::new(frame.camera, frame.light, frame.scene, options.texel_budget)
             .with_eye_samples(frame.eye_samples)
             .with_depth_bounds(depth_bounds_of(frame.camera, frame.eye_samples))
             .with_pixels_per_radian(frame.pixels_per_radian);
-        let shadow = fit(&kind.technique(options), &input).map_err(|e| fail(kind, &e))?;
+        let shadow =
+            fit_with_state(&kind.technique(options), &input, state).map_err(|e| fail(kind, &e))?;
         let chosen = TechniqueKind::of(shadow.technique()).unwrap_or(kind);
         Ok(Self {
             kind,
