@@ -4,7 +4,7 @@ use alloc::vec::Vec;
 use core::fmt;
 
 use glam::Vec3;
-use shadowmap_frustum::math::{floor, powf, sqrt};
+use shadowmap_frustum::math::{floor, sqrt};
 use shadowmap_frustum::{
     Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, DepthBounds,
     FrustumError, Light, MAX_CASCADES, SceneBounds, SplitScheme, TechniqueSelector, ValidCamera,
@@ -357,20 +357,27 @@ fn fit_warped(
     Ok((fitted, u32::try_from(count).unwrap_or(u32::MAX)))
 }
 
-/// A count kept from the previous frame stays while its cost is within this factor
+/// A count kept from the previous frame stays while its score is within this factor
 /// of the best count's (see [`cascade_splits`]).
 const COUNT_KEEP_RATIO: f64 = 1.1;
 
 /// Splits of the cascaded techniques: practical splits of the depth bounds (the
-/// camera's range without them), so no cascade covers empty depth. The count follows
-/// the bounds' ratio `r = max / min`: with `k` maps sharing the budget, a
-/// logarithmic split leaves each cascade a depth ratio `r^(1/k)` on `side(k)` texels,
-/// so the count minimizing `r^(1/k) / side(k)` is taken, among the counts up to
-/// `plan.max_cascades` whose side is a power of two when there are any (the stable
-/// fit's whole-texel motion is exact in `f32` only there). The count of the previous
-/// frame (held in `state`) is kept while its cost is within [`COUNT_KEEP_RATIO`] of
-/// the best, so a depth range near the boundary between two counts does not
-/// re-size every map from one frame to the next.
+/// camera's range without them), so no cascade covers empty depth.
+///
+/// The count is the one whose coarsest cascade is finest where it matters: the
+/// perspective aliasing of a cascade is largest at its near end, where a texel of
+/// world size `t` covers the most pixels, in proportion to `t / z_near`. For each
+/// count `k` up to `plan.max_cascades` (only those whose map side is a power of two
+/// when there are any: the stable fit's whole-texel motion is exact in `f32` only
+/// there), the slices are fitted tight to slice ∩ receivers on `side(k)` texels and
+/// scored by the largest `t / z_near` over the cascades that meet the receivers; the
+/// lowest score wins. Where the receivers bound the view (a room), the far slices'
+/// footprints stop growing with depth and fewer, larger maps win; over open ground
+/// the footprint grows with depth and more cascades win (Zhang et al.'s reasoning
+/// for parallel splits). The count of the previous frame (held in `state`) is kept
+/// while its score is within [`COUNT_KEEP_RATIO`] of the best, so a view near the
+/// boundary between two counts does not re-size every map from one frame to the
+/// next.
 fn cascade_splits(
     plan: &CascadePlan,
     input: &FitInput<'_>,
@@ -381,27 +388,64 @@ fn cascade_splits(
         Some(bounds) => bounds.clamped_to(camera)?,
         None => camera.depth_range()?,
     };
-    let ratio = f64::from(far) / f64::from(near);
     let max = plan.max_cascades.clamp(1, MAX_CASCADES);
     let side = |k: usize| input.layer_side(u32::try_from(k).unwrap_or(u32::MAX));
     let any_power = (1..=max).any(|k| side(k).is_power_of_two());
     let allowed = |k: usize| (1..=max).contains(&k) && (!any_power || side(k).is_power_of_two());
-    let cost = |k: usize| powf(ratio, 1.0 / k as f64) / f64::from(side(k));
-    let best = (1..=max)
-        .filter(|k| allowed(*k))
-        .min_by(|a, b| cost(*a).total_cmp(&cost(*b)))
-        .unwrap_or(1);
-    let kept = state.count();
-    let count = if allowed(kept) && cost(kept) <= cost(best) * COUNT_KEEP_RATIO {
-        kept
-    } else {
-        best
-    };
-    state.set_count(count);
     let scheme = SplitScheme::Practical {
         lambda: plan.split_lambda,
     };
-    Ok(CascadeSplits::new(&scheme, count, near, far)?.with_overlap(plan.overlap)?)
+    let splits_of = |k: usize| -> Result<CascadeSplits, FitError> {
+        Ok(CascadeSplits::new(&scheme, k, near, far)?.with_overlap(plan.overlap)?)
+    };
+    let valid = ValidCamera::new(camera)?;
+    let direction = match *input.light {
+        Light::Directional { direction } => direction,
+        _ => Vec3::ZERO,
+    };
+    let mut scores = [f64::INFINITY; MAX_CASCADES + 1];
+    for (k, score) in scores.iter_mut().enumerate() {
+        if allowed(k) {
+            let splits = splits_of(k)?;
+            *score = coarseness(&valid, direction, &splits, side(k), &input.scene);
+        }
+    }
+    let best = (1..=max)
+        .filter(|k| allowed(*k))
+        .min_by(|a, b| scores[*a].total_cmp(&scores[*b]).then(b.cmp(a)))
+        .unwrap_or(1);
+    let kept = state.count();
+    let keep = allowed(kept) && scores[kept] <= scores[best] * COUNT_KEEP_RATIO;
+    let count = if keep { kept } else { best };
+    state.set_count(count);
+    splits_of(count)
+}
+
+/// The score of a split in [`cascade_splits`]: the largest texel size over near
+/// depth, `t / z_near`, of its cascades fitted tight to slice ∩ receivers on
+/// `side`-texel maps, over the cascades that meet the receivers (infinite when the
+/// fit fails or none does).
+fn coarseness(
+    camera: &ValidCamera,
+    direction: Vec3,
+    splits: &CascadeSplits,
+    side: u32,
+    scene: &SceneBounds,
+) -> f64 {
+    let options = CascadeOptions::default()
+        .with_resolution(side)
+        .with_fit(CascadeFit::Tight)
+        .with_scene(Some(*scene));
+    let Ok(set) = CascadeSet::fit_valid(camera, direction, splits, &options) else {
+        return f64::INFINITY;
+    };
+    set.cascades
+        .iter()
+        .filter(|c| !c.receivers_missed)
+        .map(|c| f64::from(c.texel_world_size) / f64::from(c.view_depth.0))
+        .filter(|s| s.is_finite())
+        .max_by(f64::total_cmp)
+        .unwrap_or(f64::INFINITY)
 }
 
 fn fit_rtw(

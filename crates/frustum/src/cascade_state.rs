@@ -11,7 +11,11 @@ use crate::{FrustumError, MAX_CASCADES};
 pub const STABLE_HEADROOM: f64 = 1.25;
 
 /// Largest ratio of a held size to the footprint it covers before the map shrinks.
-pub const STABLE_SHRINK_RATIO: f64 = 1.5;
+/// Shrinking only gives texels back (a map that is too big still covers), so the
+/// band is wider on this side: after a resize the footprint may shrink to
+/// `STABLE_HEADROOM / STABLE_SHRINK_RATIO` (about 0.71) of its size, as it may grow
+/// by [`STABLE_HEADROOM`], before the size changes again.
+pub const STABLE_SHRINK_RATIO: f64 = 1.75;
 
 /// What the stable cascade fit remembers from one frame to the next: each cascade's
 /// map size in light-space units (per axis), and the cascade count the caller chose.
@@ -153,7 +157,7 @@ mod tests {
         // Grows past the headroom: renewed.
         let renewed = hold_size(first, n * 1.3);
         assert!(renewed.cmpge(n * 1.3 * STABLE_HEADROOM).all());
-        // Shrinks to 80%: at most 1.5x too big, kept; to half: renewed.
+        // Shrinks to 80%: at most 1.75x too big, kept; to half: renewed.
         assert_eq!(hold_size(first, n * 0.9), first);
         assert!(hold_size(first, n * 0.5).cmplt(first).all());
         // Axes are independent.
