@@ -80,10 +80,18 @@
 //! | `Dpsm` | point | 2 | | Brabec, Annen and Seidel, *Shadow mapping for hemispherical and omnidirectional light sources* |
 //! | `Ipsm` | point | 1 or 2 | D | Vanek, Navrátil, Herout and Zemčík, *High-quality shadows with improved paraboloid mapping*; `ConeFit::Exact` uses the exact minimal enclosing cone |
 //!
-//! Cascade count: with depth bounds of ratio `r = max / min` and `k` maps sharing the
-//! budget, each cascade of a logarithmic split covers a ratio `r^(1/k)` on `side(k)`
-//! texels; the count minimizing `r^(1/k) / side(k)` up to
-//! [`CascadePlan::max_cascades`] is taken, preferring power-of-two sides.
+//! Cascade count: for each count `k` up to [`CascadePlan::max_cascades`] (preferring
+//! power-of-two sides), practical splits of the depth bounds are fitted tight to
+//! slice ∩ receivers on `side(k)` texels, and the count whose coarsest cascade has
+//! the smallest texel size over near depth wins: open ground gets several cascades,
+//! a small room one map of the whole budget.
+//!
+//! Across frames, [`fit_with_state`] threads a caller-held [`FitState`]: `auto`'s
+//! choice, the cascade count (kept unless another is clearly better) and each stable
+//! cascade's map size, fitted to slice ∩ receivers with
+//! [`STABLE_HEADROOM`](frustum::STABLE_HEADROOM) and kept while it still covers
+//! the footprint and is at most [`STABLE_SHRINK_RATIO`](frustum::STABLE_SHRINK_RATIO)
+//! times too big, so the maps move by whole texels and shadow edges do not shimmer.
 //!
 //! `auto` fits every candidate and keeps the lowest predicted 95th-percentile error
 //! (`shadowmap_frustum::predict_errors`, from camera, light and bounds alone: no

@@ -47,9 +47,10 @@ pub use auto::AUTO_CANDIDATES;
 pub enum TechniqueKind {
     /// Orthographic fit of frustum ∩ receivers (`shadowmap_warp::uniform_focused`).
     UniformFocused,
-    /// PSSM, stable: `CascadeSet::fit` with the stable fit clipped to the receivers on a
-    /// ladder of sizes; practical splits of the eye's depth bounds, cascade count from
-    /// their ratio (see `cascade_splits`).
+    /// PSSM, stable: `CascadeSet::fit_with_state`, each map fitted to slice ∩
+    /// receivers with headroom and its size held along the camera path with
+    /// hysteresis; practical splits of the eye's depth bounds, the count from the
+    /// fitted footprints (see `shadowmap::fit_with_state`).
     StableCascades,
     /// PSSM, tight (SDSM-style): `CascadeSet::fit` with the tight fit to slice ∩
     /// receivers over the same splits as [`TechniqueKind::StableCascades`].
