@@ -527,6 +527,32 @@ mod tests {
     }
 
     #[test]
+    fn faces_the_light_does_not_face_are_left_out() {
+        // From inside the box the rays leave through the floor (lit from above), the
+        // far wall and the ceiling (not lit).
+        let map = overhead(400.0);
+        let predict = |options: PredictOptions| {
+            predict_error(&camera(), &ground(), &map, 1024, &options)
+                .unwrap()
+                .unwrap()
+        };
+        let all = predict(PredictOptions::default());
+        let lit = predict(PredictOptions::default().with_light_direction(Vec3::NEG_Y));
+        assert!(
+            lit.rays > 0 && lit.rays < all.rays,
+            "{} of {}",
+            lit.rays,
+            all.rays
+        );
+        // Lit from below, only the ceiling counts.
+        let below = predict(PredictOptions::default().with_light_direction(Vec3::Y));
+        assert!(below.rays > 0 && below.rays < all.rays);
+        // A zero direction is no light: every ray.
+        let none = predict(PredictOptions::default().with_light_direction(Vec3::ZERO));
+        assert_eq!(none, all);
+    }
+
+    #[test]
     fn a_finer_map_predicts_a_proportionally_smaller_error() {
         let (c, g, map) = (camera(), ground(), overhead(250.0));
         let o = PredictOptions::default();
