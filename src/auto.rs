@@ -2,11 +2,11 @@
 
 use arrayvec::ArrayVec;
 use shadowmap_frustum::{
-    CascadeState, PredictOptions, PredictedError, ShadowMapping, TechniqueSelector, predict_errors,
+    PredictOptions, PredictedError, ShadowMapping, TechniqueSelector, predict_errors,
 };
 use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 
-use crate::fit::{FitError, FitInput, fit_stateful};
+use crate::fit::{FitError, FitInput, fit_with_selector};
 use crate::shadow::Shadow;
 use crate::technique::{CascadePlan, Technique};
 
@@ -41,12 +41,11 @@ pub(crate) fn fit_auto(
     plan: &CascadePlan,
     input: &FitInput<'_>,
     selector: &mut TechniqueSelector,
-    cascades: &mut CascadeState,
 ) -> Result<Shadow, FitError> {
     let candidates = auto_candidates(plan);
     let mut fitted: [Option<Shadow>; AUTO_CANDIDATE_COUNT] = Default::default();
     for (slot, technique) in fitted.iter_mut().zip(&candidates) {
-        *slot = fit_stateful(technique, input, selector, cascades).ok();
+        *slot = fit_with_selector(technique, input, selector).ok();
     }
     let percentiles = predict(&fitted, input)?;
     let chosen = selector.choose(&percentiles).ok_or(FitError::NoCandidate)?;
@@ -76,17 +75,11 @@ fn predict(
     let predicted = predicted
         .get_mut(..mappings.len())
         .ok_or(FitError::NoCandidate)?;
-    // Surfaces the light does not face are dark whatever the map holds: the
-    // prediction ranks the candidates on the lit faces of the receivers' box.
-    let mut options = PredictOptions::default();
-    if let shadowmap_frustum::Light::Directional { direction } = *input.light {
-        options = options.with_light_direction(direction);
-    }
     predict_errors(
         input.camera,
         &input.scene.receivers,
         &mappings,
-        &options,
+        &PredictOptions::default(),
         predicted,
     )?;
     let mut percentiles = [None; AUTO_CANDIDATE_COUNT];
