@@ -22,7 +22,7 @@
 //! ```
 
 use glam::Vec3;
-use shadowmap::{Fitted, Shadow};
+use shadowmap::{Fitted, Shadow, Technique};
 use shadowmap_frustum::Camera;
 
 use crate::render::{HeadlessRenderer, RenderOptions, RenderedFrame, ShadowTechnique};
@@ -56,12 +56,17 @@ impl HeadlessRenderer {
 /// view of its tables lives for the call).
 ///
 /// # Errors
-/// [`BackendError::InvalidInput`] for a result the backend has no pass for (a
-/// `Fitted` variant added after this backend).
+/// [`BackendError::InvalidInput`] for a result the backend has no pass for (RTW over
+/// the spot fit or over a paraboloid, a `Fitted` variant added after this backend).
 pub fn with_technique<R>(
     shadow: &Shadow,
     f: impl FnOnce(&ShadowTechnique<'_>) -> R,
 ) -> Result<R, BackendError> {
+    // The RTW passes warp an orthographic base; RTW over the spot fit's perspective
+    // base has no pass yet.
+    if matches!(shadow.technique(), Technique::SpotRtw(_)) {
+        return Err(UNSUPPORTED);
+    }
     let rtw = shadow.rtw();
     let technique = match (shadow.fitted(), &rtw) {
         (_, Some(rtw)) => ShadowTechnique::Rtw(rtw),

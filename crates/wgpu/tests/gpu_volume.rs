@@ -18,7 +18,6 @@ use shadowmap_eval::technique::{
 };
 use shadowmap_frustum::{Aabb, Camera, Light, Projection};
 use shadowmap_volume::{OccluderMask, Partition, ProjectiveShadow};
-use shadowmap_wgpu::GpuContext;
 use shadowmap_wgpu::depth::DepthBias;
 use shadowmap_wgpu::render::{
     HeadlessRenderer, MaskValue, RenderOptions, ShadowBias, ShadowFilter, ShadowMask,
@@ -26,6 +25,7 @@ use shadowmap_wgpu::render::{
 use shadowmap_wgpu::volume::{
     GpuSilhouette, ProjectiveRenderer, VolumeMethod, VolumeRenderer, VolumeScene, misclassification,
 };
+use shadowmap_wgpu::{BackendError, GpuContext};
 
 const W: u32 = 480;
 const H: u32 = 270;
@@ -213,7 +213,19 @@ fn gpu_misclassification_matches_the_cpu_for_every_technique() {
     ) else {
         return;
     };
-    let config = configuration("overhead");
+    // A directional, a spot and a point light: every technique of each that the
+    // backend renders.
+    let mut checked = 0;
+    for name in ["overhead", "facing_spot", "point_mid"] {
+        checked += misclassification_gaps(&ctx, &configuration(name));
+    }
+    assert!(checked >= 12, "only {checked} techniques compared");
+}
+
+/// Compares, for every technique of `config`'s light that the backend renders, the
+/// GPU misclassification against the volumes with eval's CPU misclassification
+/// against the ray caster (within 0.2 percentage points); returns how many.
+fn misclassification_gaps(ctx: &GpuContext, config: &Configuration) -> usize {
     let (camera, light, mesh) = (config.camera(), &config.light, &config.scene.mesh);
     let bvh = Bvh::build(mesh).unwrap();
     let gbuffer = GBuffer::trace(&bvh, camera, W, H).unwrap();
@@ -222,7 +234,7 @@ fn gpu_misclassification_matches_the_cpu_for_every_technique() {
     let mut volumes = VolumeScene::new(&tris).unwrap();
     let volume_mask = VolumeRenderer::new()
         .render_mask(
-            &ctx,
+            ctx,
             &mut volumes,
             camera,
             light,
@@ -262,9 +274,12 @@ fn gpu_misclassification_matches_the_cpu_for_every_technique() {
         };
         let map = technique.rasterize(mesh, &raster).unwrap();
         let cpu = CpuMask::from_map(&gbuffer, &technique, &map, LOOKUP_BIAS).compare(&truth);
-        let frame = renderer
-            .render_shadow(&ctx, &tris, camera, technique.shadow(), &render)
-            .unwrap();
+        let frame = match renderer.render_shadow(ctx, &tris, camera, technique.shadow(), &render) {
+            Ok(frame) => frame,
+            // Techniques the backend has no pass for (RTW over a paraboloid).
+            Err(BackendError::InvalidInput(_)) => continue,
+            Err(e) => panic!("{}: {e}", kind.name()),
+        };
         let (gpu, _) = misclassification(&frame.mask, &volume_mask);
         let gap = 100.0 * (gpu.rate() - cpu.rate());
         eprintln!(
@@ -277,12 +292,13 @@ fn gpu_misclassification_matches_the_cpu_for_every_technique() {
         );
         assert!(
             gap.abs() <= 0.2,
-            "{}: gap {gap} percentage points",
-            kind.name()
+            "{} on {}: gap {gap} percentage points",
+            kind.name(),
+            config.name
         );
         checked += 1;
     }
-    assert!(checked >= 5, "only {checked} techniques fitted");
+    checked
 }
 
 /// Mask side of the projective shadows.
