@@ -2,11 +2,11 @@
 
 use arrayvec::ArrayVec;
 use shadowmap_frustum::{
-    PredictOptions, PredictedError, ShadowMapping, TechniqueSelector, predict_errors,
+    CascadeState, PredictOptions, PredictedError, ShadowMapping, TechniqueSelector, predict_errors,
 };
 use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 
-use crate::fit::{FitError, FitInput, fit_with_selector};
+use crate::fit::{FitError, FitInput, fit_stateful};
 use crate::shadow::Shadow;
 use crate::technique::{CascadePlan, Technique};
 
@@ -41,11 +41,12 @@ pub(crate) fn fit_auto(
     plan: &CascadePlan,
     input: &FitInput<'_>,
     selector: &mut TechniqueSelector,
+    cascades: &mut CascadeState,
 ) -> Result<Shadow, FitError> {
     let candidates = auto_candidates(plan);
     let mut fitted: [Option<Shadow>; AUTO_CANDIDATE_COUNT] = Default::default();
     for (slot, technique) in fitted.iter_mut().zip(&candidates) {
-        *slot = fit_with_selector(technique, input, selector).ok();
+        *slot = fit_stateful(technique, input, selector, cascades).ok();
     }
     let percentiles = predict(&fitted, input)?;
     let chosen = selector.choose(&percentiles).ok_or(FitError::NoCandidate)?;
@@ -75,11 +76,17 @@ fn predict(
     let predicted = predicted
         .get_mut(..mappings.len())
         .ok_or(FitError::NoCandidate)?;
+    // Surfaces the light does not face are dark whatever the map holds: the
+    // prediction ranks the candidates on the lit faces of the receivers' box.
+    let mut options = PredictOptions::default();
+    if let shadowmap_frustum::Light::Directional { direction } = *input.light {
+        options = options.with_light_direction(direction);
+    }
     predict_errors(
         input.camera,
         &input.scene.receivers,
         &mappings,
-        &PredictOptions::default(),
+        &options,
         predicted,
     )?;
     let mut percentiles = [None; AUTO_CANDIDATE_COUNT];

@@ -4,11 +4,11 @@ use alloc::vec::Vec;
 use core::fmt;
 
 use glam::{DVec3, Vec3};
-use shadowmap_frustum::math::{floor, powf, sqrt};
+use shadowmap_frustum::math::{floor, sqrt};
 use shadowmap_frustum::{
-    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, FrustumError,
-    Light, MAX_CASCADES, SceneBounds, ShadowMapping, ShadowTransform, SplitScheme,
-    TechniqueSelector, fit_spot,
+    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, DepthBounds,
+    FrustumError, Light, MAX_CASCADES, SceneBounds, ShadowMapping, ShadowTransform, SplitScheme,
+    TechniqueSelector, ValidCamera, fit_spot,
 };
 use shadowmap_paraboloid::{CubeMap, IpsmOptions, IpsmPlan, ParaboloidError, ParaboloidMap, Side};
 use shadowmap_rtw::{BasePoint, EyeSample, ImportanceMap, OracleAxis, RtwError, WarpMaps};
@@ -193,7 +193,8 @@ pub fn fit(technique: &Technique, input: &FitInput<'_>) -> Result<Shadow, FitErr
 
 /// [`fit`], with the caller's `selector` keeping `auto`'s choice across frames
 /// (hysteresis: it switches only when another candidate is predicted better by the
-/// selector's margin). Other techniques ignore the selector.
+/// selector's margin). Other techniques ignore the selector; stable cascades start
+/// from a fresh [`CascadeState`] (use [`fit_with_state`] to keep their sizes).
 ///
 /// # Errors
 /// As [`fit`].
@@ -201,6 +202,44 @@ pub fn fit_with_selector(
     technique: &Technique,
     input: &FitInput<'_>,
     selector: &mut TechniqueSelector,
+) -> Result<Shadow, FitError> {
+    fit_stateful(technique, input, selector, &mut CascadeState::new())
+}
+
+/// What a renderer keeps from one frame to the next for one light and view:
+/// `auto`'s choice and the stable cascades' held sizes and count. Start with
+/// `FitState::default()` and pass the same value to [`fit_with_state`] every frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FitState {
+    /// `auto`'s current choice, kept with hysteresis.
+    pub selector: TechniqueSelector,
+    /// The stable cascades' sizes (and the cascaded techniques' count), kept with
+    /// hysteresis.
+    pub cascades: CascadeState,
+}
+
+/// [`fit`], with the caller-held `state` threaded through the frames: `auto` keeps
+/// its choice ([`TechniqueSelector`]), the stable cascades keep each map's size while
+/// it still covers slice ∩ receivers and is not too big (so the maps move by whole
+/// texels and do not shimmer), and the cascaded techniques keep their count unless
+/// another count is clearly better. Other techniques ignore the state.
+///
+/// # Errors
+/// As [`fit`].
+pub fn fit_with_state(
+    technique: &Technique,
+    input: &FitInput<'_>,
+    state: &mut FitState,
+) -> Result<Shadow, FitError> {
+    fit_stateful(technique, input, &mut state.selector, &mut state.cascades)
+}
+
+/// [`fit_with_state`] with its two parts of the state apart.
+pub(crate) fn fit_stateful(
+    technique: &Technique,
+    input: &FitInput<'_>,
+    selector: &mut TechniqueSelector,
+    cascades: &mut CascadeState,
 ) -> Result<Shadow, FitError> {
     if !technique.applies_to(input.light) {
         return Err(FitError::WrongLight {
@@ -211,9 +250,9 @@ pub fn fit_with_selector(
         return Err(FitError::InvalidBudget);
     }
     if let Technique::Auto(plan) = technique {
-        return crate::auto::fit_auto(plan, input, selector);
+        return crate::auto::fit_auto(plan, input, selector, cascades);
     }
-    let (fitted, layers) = fit_one(technique, input)?;
+    let (fitted, layers) = fit_one(technique, input, cascades)?;
     Ok(Shadow {
         requested: *technique,
         technique: *technique,
@@ -224,7 +263,11 @@ pub fn fit_with_selector(
 }
 
 /// The result and layer count of every technique but `auto`.
-fn fit_one(technique: &Technique, input: &FitInput<'_>) -> Result<(Fitted, u32), FitError> {
+fn fit_one(
+    technique: &Technique,
+    input: &FitInput<'_>,
+    state: &mut CascadeState,
+) -> Result<(Fitted, u32), FitError> {
     let (camera, scene) = (input.camera, &input.scene);
     let direction = match *input.light {
         Light::Directional { direction } => direction,
@@ -240,9 +283,11 @@ fn fit_one(technique: &Technique, input: &FitInput<'_>) -> Result<(Fitted, u32),
         Technique::Tsm(o) => (Fitted::Tsm(tsm(camera, direction, scene, o)?), 1),
         Technique::StableCascades(plan) | Technique::TightCascades(plan) => {
             let stable = matches!(technique, Technique::StableCascades(_));
-            fit_cascades(plan, stable, direction, input)?
+            fit_cascades(plan, stable, direction, input, state)?
         }
-        Technique::WarpedCascades { plan, lispsm } => fit_warped(plan, lispsm, direction, input)?,
+        Technique::WarpedCascades { plan, lispsm } => {
+            fit_warped(plan, lispsm, direction, input, state)?
+        }
         Technique::Rtw(plan) | Technique::RtwOracle(plan) => {
             let base = uniform_focused(camera, direction, scene, &Default::default())?;
             let oracle = matches!(technique, Technique::RtwOracle(_));
@@ -279,27 +324,26 @@ fn fit_one(technique: &Technique, input: &FitInput<'_>) -> Result<(Fitted, u32),
     })
 }
 
-/// Ladder step of the stable cascades' sizes: a rung every half octave.
-const STABLE_SIZE_STEP: f32 = core::f32::consts::SQRT_2;
-
 fn fit_cascades(
     plan: &CascadePlan,
     stable: bool,
     direction: Vec3,
     input: &FitInput<'_>,
+    state: &mut CascadeState,
 ) -> Result<(Fitted, u32), FitError> {
-    let splits = cascade_splits(plan, input)?;
+    let splits = cascade_splits(plan, input, state)?;
     let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
     let fit = CascadeOptions::default()
         .with_resolution(input.layer_side(layers))
         .with_reversed_z(plan.reversed_z)
-        .with_scene(Some(input.scene));
-    let fit = if stable {
-        fit.with_stable_size_step(Some(STABLE_SIZE_STEP))
-    } else {
-        fit.with_fit(CascadeFit::Tight)
-    };
-    let set = CascadeSet::fit(input.camera, direction, &splits, &fit)?;
+        .with_scene(Some(input.scene))
+        .with_fit(if stable {
+            CascadeFit::Stable
+        } else {
+            CascadeFit::Tight
+        });
+    let camera = ValidCamera::new(input.camera)?;
+    let set = CascadeSet::fit_with_state(&camera, direction, &splits, &fit, state)?;
     Ok((Fitted::Cascades(set), layers))
 }
 
@@ -308,10 +352,11 @@ fn fit_warped(
     options: &LispsmOptions,
     direction: Vec3,
     input: &FitInput<'_>,
+    state: &mut CascadeState,
 ) -> Result<(Fitted, u32), FitError> {
     // The same split rule as the unwarped cascades: count and range from the depth
     // bounds, so no cascade is spent on empty depth.
-    let splits = cascade_splits(plan, input)?;
+    let splits = cascade_splits(plan, input, state)?;
     let count = splits.count();
     let etas = [options.eta; MAX_CASCADES];
     let cascades = warped_cascades(
@@ -330,32 +375,95 @@ fn fit_warped(
     Ok((fitted, u32::try_from(count).unwrap_or(u32::MAX)))
 }
 
+/// A count kept from the previous frame stays while its score is within this factor
+/// of the best count's (see [`cascade_splits`]).
+const COUNT_KEEP_RATIO: f64 = 1.1;
+
 /// Splits of the cascaded techniques: practical splits of the depth bounds (the
-/// camera's range without them), so no cascade covers empty depth. The count follows
-/// the bounds' ratio `r = max / min`: with `k` maps sharing the budget, a
-/// logarithmic split leaves each cascade a depth ratio `r^(1/k)` on `side(k)` texels,
-/// so the count minimizing `r^(1/k) / side(k)` is taken, among the counts up to
-/// `plan.max_cascades` whose side is a power of two when there are any (the stable
-/// fit's whole-texel motion is exact in `f32` only there).
-fn cascade_splits(plan: &CascadePlan, input: &FitInput<'_>) -> Result<CascadeSplits, FitError> {
+/// camera's range without them), so no cascade covers empty depth.
+///
+/// The count is the one whose coarsest cascade is finest where it matters: the
+/// perspective aliasing of a cascade is largest at its near end, where a texel of
+/// world size `t` covers the most pixels, in proportion to `t / z_near`. For each
+/// count `k` up to `plan.max_cascades` (only those whose map side is a power of two
+/// when there are any: the stable fit's whole-texel motion is exact in `f32` only
+/// there), the slices are fitted tight to slice ∩ receivers on `side(k)` texels and
+/// scored by the largest `t / z_near` over the cascades that meet the receivers; the
+/// lowest score wins. Where the receivers bound the view (a room), the far slices'
+/// footprints stop growing with depth and fewer, larger maps win; over open ground
+/// the footprint grows with depth and more cascades win (Zhang et al.'s reasoning
+/// for parallel splits). The count of the previous frame (held in `state`) is kept
+/// while its score is within [`COUNT_KEEP_RATIO`] of the best, so a view near the
+/// boundary between two counts does not re-size every map from one frame to the
+/// next.
+fn cascade_splits(
+    plan: &CascadePlan,
+    input: &FitInput<'_>,
+    state: &mut CascadeState,
+) -> Result<CascadeSplits, FitError> {
     let camera = input.camera;
     let (near, far) = match input.depth_bounds {
         Some(bounds) => bounds.clamped_to(camera)?,
         None => camera.depth_range()?,
     };
-    let ratio = f64::from(far) / f64::from(near);
     let max = plan.max_cascades.clamp(1, MAX_CASCADES);
     let side = |k: usize| input.layer_side(u32::try_from(k).unwrap_or(u32::MAX));
     let any_power = (1..=max).any(|k| side(k).is_power_of_two());
-    let cost = |k: usize| powf(ratio, 1.0 / k as f64) / f64::from(side(k));
-    let count = (1..=max)
-        .filter(|k| !any_power || side(*k).is_power_of_two())
-        .min_by(|a, b| cost(*a).total_cmp(&cost(*b)))
-        .unwrap_or(1);
+    let allowed = |k: usize| (1..=max).contains(&k) && (!any_power || side(k).is_power_of_two());
     let scheme = SplitScheme::Practical {
         lambda: plan.split_lambda,
     };
-    Ok(CascadeSplits::new(&scheme, count, near, far)?.with_overlap(plan.overlap)?)
+    let splits_of = |k: usize| -> Result<CascadeSplits, FitError> {
+        Ok(CascadeSplits::new(&scheme, k, near, far)?.with_overlap(plan.overlap)?)
+    };
+    let valid = ValidCamera::new(camera)?;
+    let direction = match *input.light {
+        Light::Directional { direction } => direction,
+        _ => Vec3::ZERO,
+    };
+    let mut scores = [f64::INFINITY; MAX_CASCADES + 1];
+    for (k, score) in scores.iter_mut().enumerate() {
+        if allowed(k) {
+            let splits = splits_of(k)?;
+            *score = coarseness(&valid, direction, &splits, side(k), &input.scene);
+        }
+    }
+    let best = (1..=max)
+        .filter(|k| allowed(*k))
+        .min_by(|a, b| scores[*a].total_cmp(&scores[*b]).then(b.cmp(a)))
+        .unwrap_or(1);
+    let kept = state.count();
+    let keep = allowed(kept) && scores[kept] <= scores[best] * COUNT_KEEP_RATIO;
+    let count = if keep { kept } else { best };
+    state.set_count(count);
+    splits_of(count)
+}
+
+/// The score of a split in [`cascade_splits`]: the largest texel size over near
+/// depth, `t / z_near`, of its cascades fitted tight to slice ∩ receivers on
+/// `side`-texel maps, over the cascades that meet the receivers (infinite when the
+/// fit fails or none does).
+fn coarseness(
+    camera: &ValidCamera,
+    direction: Vec3,
+    splits: &CascadeSplits,
+    side: u32,
+    scene: &SceneBounds,
+) -> f64 {
+    let options = CascadeOptions::default()
+        .with_resolution(side)
+        .with_fit(CascadeFit::Tight)
+        .with_scene(Some(*scene));
+    let Ok(set) = CascadeSet::fit_valid(camera, direction, splits, &options) else {
+        return f64::INFINITY;
+    };
+    set.cascades
+        .iter()
+        .filter(|c| !c.receivers_missed)
+        .map(|c| f64::from(c.texel_world_size) / f64::from(c.view_depth.0))
+        .filter(|s| s.is_finite())
+        .max_by(f64::total_cmp)
+        .unwrap_or(f64::INFINITY)
 }
 
 /// RTW over `base` (the uniform fit of a directional light, the spot fit of a spot

@@ -83,10 +83,18 @@
 //! | `SpotRtw` | spot | 1 | **S** | Rosen's RTW over the spot fit (a perspective base) |
 //! | `PointRtw` | point | 1 or 2 | **S**, D | Rosen's RTW over each side of the IPSM paraboloid |
 //!
-//! Cascade count: with depth bounds of ratio `r = max / min` and `k` maps sharing the
-//! budget, each cascade of a logarithmic split covers a ratio `r^(1/k)` on `side(k)`
-//! texels; the count minimizing `r^(1/k) / side(k)` up to
-//! [`CascadePlan::max_cascades`] is taken, preferring power-of-two sides.
+//! Cascade count: for each count `k` up to [`CascadePlan::max_cascades`] (preferring
+//! power-of-two sides), practical splits of the depth bounds are fitted tight to
+//! slice ∩ receivers on `side(k)` texels, and the count whose coarsest cascade has
+//! the smallest texel size over near depth wins: open ground gets several cascades,
+//! a small room one map of the whole budget.
+//!
+//! Across frames, [`fit_with_state`] threads a caller-held [`FitState`]: `auto`'s
+//! choice, the cascade count (kept unless another is clearly better) and each stable
+//! cascade's map size, fitted to slice ∩ receivers with
+//! [`STABLE_HEADROOM`](frustum::STABLE_HEADROOM) and kept while it still covers
+//! the footprint and is at most [`STABLE_SHRINK_RATIO`](frustum::STABLE_SHRINK_RATIO)
+//! times too big, so the maps move by whole texels and shadow edges do not shimmer.
 //!
 //! `auto` fits every candidate and keeps the lowest predicted 95th-percentile error
 //! (`shadowmap_frustum::predict_errors`, from camera, light and bounds alone: no
@@ -125,7 +133,10 @@ mod technique;
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 pub use auto::{AUTO_CANDIDATE_COUNT, auto_candidates};
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
-pub use fit::{FitError, FitInput, depth_bounds_of, fit, fit_with_selector, layer_side};
+pub use fit::{
+    FitError, FitInput, FitState, depth_bounds_of, fit, fit_with_selector, fit_with_state,
+    layer_side,
+};
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 pub use shadow::{Fitted, Shadow};
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]

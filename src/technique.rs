@@ -16,8 +16,9 @@ pub enum Technique {
     /// Orthographic fit of frustum ∩ receivers, near plane pulled back to the casters
     /// (`shadowmap_warp::uniform_focused`). Directional light.
     UniformFocused(UniformOptions),
-    /// Parallel-split shadow maps (Zhang et al.), stable fit: rotation-invariant size
-    /// on a ladder of sizes, texel snapping, clipped to the receivers. Directional
+    /// Parallel-split shadow maps (Zhang et al.), stable fit: each map fitted to
+    /// slice ∩ receivers with headroom, its size held across frames with hysteresis
+    /// ([`fit_with_state`](crate::fit_with_state)), texel snapping. Directional
     /// light.
     StableCascades(CascadePlan),
     /// Parallel-split shadow maps, tight fit to slice ∩ receivers (SDSM-style).

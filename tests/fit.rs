@@ -5,13 +5,13 @@
 use glam::{DVec3, Vec3};
 use proptest::prelude::*;
 use shadowmap::frustum::{
-    Aabb, Camera, ConvexBody, Light, Projection, SceneBounds, ShadowMapping, ShadowTransform,
-    TechniqueSelector,
+    Aabb, Camera, ConvexBody, DepthBounds, Light, Projection, SceneBounds, ShadowMapping,
+    ShadowTransform, TechniqueSelector,
 };
 use shadowmap::rtw::EyeSample;
 use shadowmap::{
-    FitError, FitInput, Fitted, LightKind, Shadow, Technique, depth_bounds_of, fit,
-    fit_with_selector,
+    CascadePlan, FitError, FitInput, FitState, Fitted, LightKind, Shadow, Technique,
+    depth_bounds_of, fit, fit_with_selector, fit_with_state,
 };
 use shadowmap_testgen::arbitrary::Unstructured;
 use shadowmap_testgen::paraboloid::plan_input;
@@ -386,4 +386,107 @@ fn auto_reports_its_choice_and_keeps_it_with_a_selector() {
     let kept = fit_with_selector(&auto, &input, &mut selector).unwrap();
     assert!(matches!(kept.technique(), Technique::UniformFocused(_)));
     assert_eq!(selector.current, Some(0));
+}
+
+/// The stable cascades of a camera walking and turning down the street, fitted with
+/// one `FitState` threaded through the frames, and the tight cascades of frame 0.
+fn street_walk() -> (Vec<Shadow>, Shadow, Vec<Vec3>) {
+    let (first, scene) = street();
+    let light = Light::Directional {
+        direction: Vec3::new(0.4, -1.0, 0.3),
+    };
+    let points = visible_ground(&first, &scene);
+    let bounds = depth_bounds_of(&first, &eye_samples(&first, &points));
+    let plan = CascadePlan::default();
+    let mut state = FitState::default();
+    let stable: Vec<Shadow> = (0..6)
+        .map(|k| {
+            let t = k as f32;
+            let forward = Vec3::new(0.004 * t, -0.2, -1.0);
+            let camera = Camera::look_to(
+                Vec3::new(0.3 * t, 2.0, -1.1 * t),
+                forward,
+                Vec3::Y,
+                Projection::perspective(1.0, 16.0 / 9.0, 0.5, 300.0),
+            )
+            .unwrap();
+            let input = FitInput::new(&camera, &light, scene, BUDGET).with_depth_bounds(bounds);
+            fit_with_state(&Technique::StableCascades(plan), &input, &mut state).unwrap()
+        })
+        .collect();
+    let input = FitInput::new(&first, &light, scene, BUDGET).with_depth_bounds(bounds);
+    let tight = fit(&Technique::TightCascades(plan), &input).unwrap();
+    (stable, tight, points)
+}
+
+fn cascades(shadow: &Shadow) -> &shadowmap::frustum::CascadeSet {
+    match shadow.fitted() {
+        Fitted::Cascades(set) => set,
+        other => panic!("not cascades: {other:?}"),
+    }
+}
+
+#[test]
+fn stable_cascades_with_a_fit_state_hold_their_size_and_move_by_whole_texels() {
+    let (stable, _, points) = street_walk();
+    let side = f64::from(stable[0].layer_side());
+    for pair in stable.windows(2) {
+        let (a, b) = (cascades(&pair[0]), cascades(&pair[1]));
+        assert_eq!(a.cascades.len(), b.cascades.len());
+        for (ca, cb) in a.cascades.iter().zip(&b.cascades) {
+            assert_eq!(ca.texel_world_size, cb.texel_world_size);
+            for p in &points {
+                let (Some(sa), Some(sb)) = (ca.transform.project(*p), cb.transform.project(*p))
+                else {
+                    continue;
+                };
+                let moved = (sb.uv - sa.uv) * side;
+                let phase = moved - moved.round();
+                assert!(phase.abs().max_element() < 1e-3, "moved {moved} texels");
+            }
+        }
+    }
+}
+
+#[test]
+fn stable_cascades_cost_at_most_the_headroom_over_tight_ones() {
+    let (stable, tight, _) = street_walk();
+    let (s, t) = (cascades(&stable[0]), cascades(&tight));
+    assert_eq!(s.cascades.len(), t.cascades.len());
+    for (cs, ct) in s.cascades.iter().zip(&t.cascades) {
+        // Headroom, its short-mantissa rounding and the snap's two texels.
+        let bound = shadowmap::frustum::STABLE_HEADROOM * (1.0 + 1.0 / 64.0) * 1.01;
+        let ratio = f64::from(cs.texel_world_size / ct.texel_world_size);
+        assert!(ratio >= 1.0 && ratio <= bound, "stable/tight texel {ratio}");
+    }
+}
+
+#[test]
+fn a_small_room_gets_fewer_cascades_than_open_ground() {
+    let light = Light::Directional {
+        direction: Vec3::new(0.3, -1.0, 0.2),
+    };
+    let count = |camera: &Camera, scene: SceneBounds, near: f32, far: f32| {
+        let bounds = DepthBounds {
+            min: near,
+            max: far,
+        };
+        let input = FitInput::new(camera, &light, scene, BUDGET).with_depth_bounds(Some(bounds));
+        fit(&Technique::TightCascades(CascadePlan::default()), &input)
+            .unwrap()
+            .layers()
+    };
+    let (street, ground) = street();
+    assert_eq!(count(&street, ground, 1.0, 300.0), 4);
+    // Inside a 6 m room seen from 2 m to 6 m every slice spans the room's width: one
+    // map of the budget is finer everywhere than four maps of a quarter each.
+    let room = Aabb::new(Vec3::new(-3.0, 0.0, -3.0), Vec3::new(3.0, 3.0, 3.0));
+    let camera = Camera::look_to(
+        Vec3::new(0.0, 1.6, 2.5),
+        Vec3::new(0.0, -0.3, -1.0),
+        Vec3::Y,
+        Projection::perspective(1.2, 16.0 / 9.0, 0.1, 100.0),
+    )
+    .unwrap();
+    assert_eq!(count(&camera, SceneBounds::whole(room), 2.0, 6.0), 1);
 }

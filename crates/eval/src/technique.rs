@@ -27,7 +27,9 @@ use shadowmap::paraboloid::{
 use shadowmap::rtw::{
     EyeSample, RtwSubdivision, WarpMaps, subdivide_for_rtw, subdivide_for_rtw_with,
 };
-use shadowmap::{CascadePlan, FitInput, Fitted, RtwPlan, Shadow, depth_bounds_of, fit};
+use shadowmap::{
+    CascadePlan, FitInput, FitState, Fitted, RtwPlan, Shadow, depth_bounds_of, fit_with_state,
+};
 use shadowmap_frustum::{Camera, Light, SceneBounds, ShadowMapping, ShadowSample};
 
 use crate::EvalError;
@@ -52,9 +54,10 @@ pub use auto::AUTO_CANDIDATES;
 pub enum TechniqueKind {
     /// Orthographic fit of frustum ∩ receivers (`shadowmap_warp::uniform_focused`).
     UniformFocused,
-    /// PSSM, stable: `CascadeSet::fit` with the stable fit clipped to the receivers on a
-    /// ladder of sizes; practical splits of the eye's depth bounds, cascade count from
-    /// their ratio (see `cascade_splits`).
+    /// PSSM, stable: `CascadeSet::fit_with_state`, each map fitted to slice ∩
+    /// receivers with headroom and its size held along the camera path with
+    /// hysteresis; practical splits of the eye's depth bounds, the count from the
+    /// fitted footprints (see `shadowmap::fit_with_state`).
     StableCascades,
     /// PSSM, tight (SDSM-style): `CascadeSet::fit` with the tight fit to slice ∩
     /// receivers over the same splits as [`TechniqueKind::StableCascades`].
@@ -318,7 +321,7 @@ fn fail(kind: TechniqueKind, reason: &dyn core::fmt::Display) -> EvalError {
 }
 
 impl Technique {
-    /// Fits `kind` to a frame with [`shadowmap::fit`] (eye samples, their depth
+    /// Fits `kind` to a single frame with [`shadowmap::fit`] (eye samples, their depth
     /// bounds and the image's focal length as the optional inputs).
     ///
     /// # Errors
@@ -329,11 +332,27 @@ impl Technique {
         frame: &FrameContext<'_>,
         options: &TechniqueOptions,
     ) -> Result<Self, EvalError> {
+        Self::build_with_state(kind, frame, options, &mut FitState::default())
+    }
+
+    /// As [`Technique::build`], for one frame of a sequence: `state` carries what a
+    /// renderer keeps from frame to frame ([`shadowmap::fit_with_state`]: `auto`'s
+    /// choice, the stable cascades' held sizes, the cascade count).
+    ///
+    /// # Errors
+    /// As [`Technique::build`].
+    pub fn build_with_state(
+        kind: TechniqueKind,
+        frame: &FrameContext<'_>,
+        options: &TechniqueOptions,
+        state: &mut FitState,
+    ) -> Result<Self, EvalError> {
         let input = FitInput::new(frame.camera, frame.light, frame.scene, options.texel_budget)
             .with_eye_samples(frame.eye_samples)
             .with_depth_bounds(depth_bounds_of(frame.camera, frame.eye_samples))
             .with_pixels_per_radian(frame.pixels_per_radian);
-        let shadow = fit(&kind.technique(options), &input).map_err(|e| fail(kind, &e))?;
+        let shadow =
+            fit_with_state(&kind.technique(options), &input, state).map_err(|e| fail(kind, &e))?;
         let chosen = TechniqueKind::of(shadow.technique()).unwrap_or(kind);
         Ok(Self {
             kind,

@@ -4,6 +4,7 @@ use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
 use crate::body::ConvexBody;
 use crate::bounding_sphere::bounding_sphere;
 use crate::camera::CameraGeometry;
+use crate::cascade_state::{CascadeState, held_box};
 use crate::light::unit;
 use crate::mapping::{LightDirection, ShadowSample, ShadowTransform, project_dmat};
 use crate::split::CascadeBlend;
@@ -215,6 +216,38 @@ impl CascadeSet {
         splits: &CascadeSplits,
         options: &CascadeOptions,
     ) -> Result<Self, FrustumError> {
+        Self::fit_inner(camera, light_direction, splits, options, None)
+    }
+
+    /// As [`CascadeSet::fit_valid`], with the stable fit's sizes held across frames
+    /// in `state` (see [`CascadeState`]): with [`CascadeFit::Stable`] and scene
+    /// bounds, each cascade's box is fitted to its slice ∩ receivers and keeps its
+    /// size from the previous frame while it covers the footprint and is not too
+    /// big (hysteresis), so the map moves by whole texels. This takes precedence
+    /// over [`CascadeOptions::stable_size_step`]. Other fits leave `state` alone.
+    ///
+    /// # Errors
+    /// As [`CascadeSet::fit_valid`]; `state` is unchanged on error.
+    pub fn fit_with_state(
+        camera: &ValidCamera,
+        light_direction: Vec3,
+        splits: &CascadeSplits,
+        options: &CascadeOptions,
+        state: &mut CascadeState,
+    ) -> Result<Self, FrustumError> {
+        let mut next = *state;
+        let set = Self::fit_inner(camera, light_direction, splits, options, Some(&mut next))?;
+        *state = next;
+        Ok(set)
+    }
+
+    fn fit_inner(
+        camera: &ValidCamera,
+        light_direction: Vec3,
+        splits: &CascadeSplits,
+        options: &CascadeOptions,
+        mut state: Option<&mut CascadeState>,
+    ) -> Result<Self, FrustumError> {
         let fitter = Fitter::new(&camera.geometry, light_direction, options)?;
         let mut set = Self {
             cascades: ArrayVec::new(),
@@ -226,7 +259,8 @@ impl CascadeSet {
             let (near, far) = splits
                 .cascade_range(i)
                 .ok_or(FrustumError::InvalidCascadeCount)?;
-            let cascade = match fitter.fit(near, far) {
+            let held = state.as_deref_mut().and_then(|s| s.slot(i));
+            let cascade = match fitter.fit(near, far, held) {
                 Err(FrustumError::SliceOutsideScene) => {
                     let mut c = fitter.fit_without_receivers(near, far)?;
                     c.receivers_missed = true;
@@ -288,7 +322,7 @@ pub fn fit_cascade(
     let geometry = camera.geometry()?;
     let fitter = Fitter::new(&geometry, light_direction, options)?;
     let (n, f) = fitter.camera.check_slice(near_depth, far_depth)?;
-    fitter.fit(n as f32, f as f32)
+    fitter.fit(n as f32, f as f32, None)
 }
 
 /// Everything a cascade fit needs that does not depend on the slice, computed once
@@ -373,10 +407,12 @@ impl<'a> Fitter<'a> {
             scene: None,
             ..*self
         };
-        receiverless.fit(near, far)
+        receiverless.fit(near, far, None)
     }
 
-    fn fit(&self, near: f32, far: f32) -> Result<Cascade, FrustumError> {
+    /// Fits the slice `[near, far]`; `held` is the caller-held size of the stable
+    /// fit (see [`CascadeState`]), used only with the stable fit and scene bounds.
+    fn fit(&self, near: f32, far: f32, held: Option<&mut DVec2>) -> Result<Cascade, FrustumError> {
         let (n, f) = self.camera.check_slice(near, far)?;
         let light = &self.light_from_world;
         let mut lo = DVec3::splat(f64::INFINITY);
@@ -427,6 +463,10 @@ impl<'a> Fitter<'a> {
                 let pad = (DVec2::splat(1e-6 * scale) - size).max(DVec2::ZERO) * 0.5;
                 let (a, b) = (lo.truncate() - pad, hi.truncate() + pad);
                 (a, b, (b - a).max_element() / res)
+            }
+            CascadeFit::Stable if self.scene.is_some() && held.is_some() => {
+                let mut none = DVec2::ZERO;
+                held_box(lo.truncate(), hi.truncate(), res, held.unwrap_or(&mut none))?
             }
             CascadeFit::Stable if self.ladder_step().is_some() => {
                 let step = self.ladder_step().unwrap_or(2.0);

@@ -85,6 +85,7 @@ mod body;
 mod bounding_sphere;
 mod camera;
 mod cascade;
+mod cascade_state;
 mod clip;
 mod depth_bounds;
 mod error;
@@ -109,6 +110,7 @@ pub use camera::{Camera, Projection};
 pub use cascade::{
     Cascade, CascadeFit, CascadeOptions, CascadeSet, MAX_RESOLUTION, SceneBounds, fit_cascade,
 };
+pub use cascade_state::{CascadeState, STABLE_HEADROOM, STABLE_SHRINK_RATIO};
 pub use clip::MAX_FRUSTUM_AABB_VERTICES;
 pub use depth_bounds::DepthBounds;
 pub use error::FrustumError;
@@ -119,8 +121,8 @@ pub use mapping::{
     LightDirection, ShadowMapping, ShadowSample, ShadowTransform, UV_FROM_CLIP, is_invertible,
 };
 pub use predict::{
-    MAX_PREDICT_CANDIDATES, MAX_PREDICT_RAYS, PredictOptions, PredictedError, TechniqueSelector,
-    predict_error, predict_errors,
+    FRONT_LIT_MIN_COS, MAX_PREDICT_CANDIDATES, MAX_PREDICT_RAYS, PredictOptions, PredictedError,
+    TechniqueSelector, predict_error, predict_errors,
 };
 pub use split::{CascadeBlend, CascadeSplits, MAX_CASCADES, SplitScheme};
 pub use spot::{SpotShadow, fit_spot};

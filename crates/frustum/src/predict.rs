@@ -40,7 +40,19 @@ pub struct PredictOptions {
     pub grid_rows: u32,
     /// The percentile of the error over the rays, in `(0, 1]`. Default 0.95.
     pub percentile: f64,
+    /// The direction a directional light travels, if known. Rays that meet a face
+    /// of the box turned away from the light, or within 3° of parallel to it
+    /// (`n · l` below [`FRONT_LIT_MIN_COS`], `l` toward the light), are left out:
+    /// shading darkens such surfaces whatever the map holds, and their true-normal
+    /// error grows without bound as the texel stretches along them, so counting
+    /// them would rank techniques by surfaces nobody sees shadowed. When no ray
+    /// meets a front-lit face, every ray counts. Default `None` (every ray).
+    pub light_direction: Option<Vec3>,
 }
+
+/// Smallest `n · l` of a face that counts as lit (see
+/// [`PredictOptions::light_direction`]).
+pub const FRONT_LIT_MIN_COS: f64 = 0.05;
 
 impl Default for PredictOptions {
     fn default() -> Self {
@@ -57,7 +69,16 @@ impl PredictOptions {
             grid_columns: 16,
             grid_rows: 9,
             percentile: 0.95,
+            light_direction: None,
         }
+    }
+
+    /// Sets [`light_direction`](Self::light_direction) (a zero or non-finite
+    /// direction: none).
+    #[must_use]
+    pub fn with_light_direction(mut self, direction: Vec3) -> Self {
+        self.light_direction = direction.try_normalize();
+        self
     }
 
     /// Sets [`viewport_height`](Self::viewport_height).
@@ -165,22 +186,74 @@ pub fn predict_errors(
         return Err(FrustumError::EmptyBounds);
     }
     let screen = Screen::new(camera, options.viewport_height)?;
+    let toward_light = options.light_direction.map(|d| -d.as_dvec3());
     let mut errors = [[0.0f64; MAX_PREDICT_RAYS]; MAX_PREDICT_CANDIDATES];
     let mut counts = [0usize; MAX_PREDICT_CANDIDATES];
-    // Shared rays first; each candidate's own rays if no ray is shared.
-    for shared in [true, false] {
+    // Front-lit shared rays first (without a light: every shared ray, twice); then
+    // every shared ray; then each candidate's own rays.
+    let passes = [(toward_light, true), (None, true), (None, false)];
+    for (lit_by, shared) in passes {
         counts = [0; MAX_PREDICT_CANDIDATES];
-        for row in 0..options.grid_rows {
-            for column in 0..options.grid_columns {
+        let pass = Pass {
+            screen: &screen,
+            receivers,
+            grid: (options.grid_columns, options.grid_rows),
+            lit_by,
+            shared,
+        };
+        pass.run(candidates, &mut errors, &mut counts);
+        if counts[..n].iter().any(|&c| c > 0) {
+            break;
+        }
+    }
+    for (i, slot) in out.iter_mut().enumerate() {
+        *slot = summarize(&mut errors[i][..counts[i]], options.percentile);
+    }
+    Ok(())
+}
+
+/// One pass of [`predict_errors`] over the ray grid.
+struct Pass<'a> {
+    screen: &'a Screen,
+    receivers: &'a Aabb,
+    grid: (u32, u32),
+    /// Only rays meeting a face lit from this direction (toward the light).
+    lit_by: Option<DVec3>,
+    /// Only rays every candidate covers.
+    shared: bool,
+}
+
+impl Pass<'_> {
+    fn run(
+        &self,
+        candidates: &[(&dyn ShadowMapping, u32)],
+        errors: &mut [[f64; MAX_PREDICT_RAYS]; MAX_PREDICT_CANDIDATES],
+        counts: &mut [usize; MAX_PREDICT_CANDIDATES],
+    ) {
+        let n = candidates.len();
+        let (columns, rows) = self.grid;
+        for row in 0..rows {
+            for column in 0..columns {
                 let at = DVec2::new(
-                    (f64::from(column) + 0.5) / f64::from(options.grid_columns),
-                    (f64::from(row) + 0.5) / f64::from(options.grid_rows),
+                    (f64::from(column) + 0.5) / f64::from(columns),
+                    (f64::from(row) + 0.5) / f64::from(rows),
                 );
+                let Some((point, normal)) = self.screen.hit(at, self.receivers) else {
+                    continue;
+                };
+                if self
+                    .lit_by
+                    .is_some_and(|l| normal.dot(l) < FRONT_LIT_MIN_COS)
+                {
+                    continue;
+                }
                 let mut ray = [None; MAX_PREDICT_CANDIDATES];
                 for (m, &(mapping, side)) in ray.iter_mut().zip(candidates) {
-                    *m = screen.error_at(at, receivers, mapping, f64::from(side));
+                    *m = self
+                        .screen
+                        .error_at(at, point, normal, mapping, f64::from(side));
                 }
-                if shared && ray[..n].iter().any(Option::is_none) {
+                if self.shared && ray[..n].iter().any(Option::is_none) {
                     continue;
                 }
                 for (i, m) in ray[..n].iter().enumerate() {
@@ -191,14 +264,7 @@ pub fn predict_errors(
                 }
             }
         }
-        if !shared || counts[..n].iter().any(|&c| c > 0) {
-            break;
-        }
     }
-    for (i, slot) in out.iter_mut().enumerate() {
-        *slot = summarize(&mut errors[i][..counts[i]], options.percentile);
-    }
-    Ok(())
 }
 
 /// The percentile and maximum of the errors (sorted in place).
@@ -257,17 +323,22 @@ impl Screen {
         (origin, bilerp(&self.far) - origin)
     }
 
-    /// `m` where the ray through `at` meets the box, if it does and the mapping covers
-    /// the pixel and its neighbours in one layer.
+    /// Where the ray through `at` first meets the box, and that face's normal.
+    fn hit(&self, at: DVec2, receivers: &Aabb) -> Option<(DVec3, DVec3)> {
+        let (origin, step) = self.ray(at);
+        first_face_hit(origin, step, receivers)
+    }
+
+    /// `m` at `point` on the face with `normal` met by the ray through `at`, if the
+    /// mapping covers the pixel and its neighbours in one layer.
     fn error_at(
         &self,
         at: DVec2,
-        receivers: &Aabb,
+        point: DVec3,
+        normal: DVec3,
         mapping: &dyn ShadowMapping,
         texels: f64,
     ) -> Option<f64> {
-        let (origin, step) = self.ray(at);
-        let (point, normal) = first_face_hit(origin, step, receivers)?;
         let centre = mapping.map_point(point)?;
         let mut columns = [DVec2::ZERO; 2];
         for (axis, column) in columns.iter_mut().enumerate() {
@@ -453,6 +524,32 @@ mod tests {
 
     fn ground() -> Aabb {
         Aabb::new(Vec3::new(-200.0, 0.0, -210.0), Vec3::new(200.0, 30.0, 10.0))
+    }
+
+    #[test]
+    fn faces_the_light_does_not_face_are_left_out() {
+        // From inside the box the rays leave through the floor (lit from above), the
+        // far wall and the ceiling (not lit).
+        let map = overhead(400.0);
+        let predict = |options: PredictOptions| {
+            predict_error(&camera(), &ground(), &map, 1024, &options)
+                .unwrap()
+                .unwrap()
+        };
+        let all = predict(PredictOptions::default());
+        let lit = predict(PredictOptions::default().with_light_direction(Vec3::NEG_Y));
+        assert!(
+            lit.rays > 0 && lit.rays < all.rays,
+            "{} of {}",
+            lit.rays,
+            all.rays
+        );
+        // Lit from below, only the ceiling counts.
+        let below = predict(PredictOptions::default().with_light_direction(Vec3::Y));
+        assert!(below.rays > 0 && below.rays < all.rays);
+        // A zero direction is no light: every ray.
+        let none = predict(PredictOptions::default().with_light_direction(Vec3::ZERO));
+        assert_eq!(none, all);
     }
 
     #[test]

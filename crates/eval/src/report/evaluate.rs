@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{DVec2, DVec3};
+use shadowmap::FitState;
 use shadowmap_frustum::{Camera, SceneBounds, ShadowMapping};
 
 use crate::EvalError;
@@ -299,7 +300,15 @@ fn measure(
     setup: &Setup,
 ) -> Result<Measured, EvalError> {
     let first = &reference.frames[0];
-    let technique = Technique::build(kind, &reference.context(first, config), &setup.technique)?;
+    // One state through the path, as a renderer keeps it (auto's choice, the stable
+    // cascades' sizes); frame 0 starts fresh.
+    let mut state = FitState::default();
+    let technique = Technique::build_with_state(
+        kind,
+        &reference.context(first, config),
+        &setup.technique,
+        &mut state,
+    )?;
     let (aliasing, pixels) = aliasing_stats(
         &technique,
         &technique.layer_sizes(),
@@ -310,7 +319,13 @@ fn measure(
     let map = technique.rasterize(&config.scene.mesh, &setup.raster)?;
     let mask = ShadowMask::from_map(&first.gbuffer, &technique, &map, LOOKUP_BIAS);
     let miss = misclassification(&mask.lit, &reference.truth_front_lit);
-    let (phase_jitter, flip_rate) = temporal(kind, config, reference, setup, &technique, &map);
+    let path = CameraRun {
+        kind,
+        config,
+        reference,
+        setup,
+    };
+    let (phase_jitter, flip_rate) = temporal(&path, &technique, &map, &mut state);
     Ok(Measured {
         metrics: RowMetrics {
             layers: technique.layers(),
@@ -326,21 +341,36 @@ fn measure(
     })
 }
 
-/// Refits the technique to every frame of the path and follows the fixed points:
-/// (phase jitter, flip rate), `None` when a frame cannot be fitted or rasterized.
-fn temporal(
+/// What [`temporal`] refits along a camera path.
+struct CameraRun<'a> {
     kind: TechniqueKind,
-    config: &Configuration,
-    reference: &Reference,
-    setup: &Setup,
+    config: &'a Configuration,
+    reference: &'a Reference,
+    setup: &'a Setup,
+}
+
+/// Refits the technique to every frame of the path after frame 0, threading `state`
+/// (left by frame 0's fit) from frame to frame as a renderer would, and follows the
+/// fixed points: (phase jitter, flip rate), `None` when a frame cannot be fitted or
+/// rasterized.
+fn temporal(
+    path: &CameraRun<'_>,
     technique: &Technique,
     map: &DepthMap,
+    state: &mut FitState,
 ) -> (Option<f64>, Option<f64>) {
+    let CameraRun {
+        kind,
+        config,
+        reference,
+        setup,
+    } = *path;
     let fixed = &reference.fixed;
     let mut texels = vec![texels_of(technique, fixed)];
     let mut lit = vec![lit_of(technique, map, fixed)];
     for f in &reference.frames[1..] {
-        let Ok(t) = Technique::build(kind, &reference.context(f, config), &setup.technique) else {
+        let context = reference.context(f, config);
+        let Ok(t) = Technique::build_with_state(kind, &context, &setup.technique, state) else {
             return (None, None);
         };
         let Ok(m) = t.rasterize(&config.scene.mesh, &setup.raster) else {

@@ -5,8 +5,8 @@ use super::TechniqueKind;
 
 /// The candidates of [`TechniqueKind::Auto`], from the most to the least preferred
 /// when predictions tie: the kinds of `shadowmap::auto_candidates`, in its order.
-/// The report fits each frame on its own, so the selector's hysteresis (which a
-/// renderer keeps across frames) does not apply here.
+/// The report threads one `shadowmap::FitState` through a camera path, as a
+/// renderer would, so the selector's hysteresis applies from the second frame on.
 pub const AUTO_CANDIDATES: [TechniqueKind; shadowmap::AUTO_CANDIDATE_COUNT] = [
     TechniqueKind::UniformFocused,
     TechniqueKind::Lispsm,
