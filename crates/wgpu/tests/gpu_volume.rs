@@ -214,9 +214,11 @@ fn gpu_misclassification_matches_the_cpu_for_every_technique() {
         return;
     };
     // A directional, a spot and a point light: every technique of each that the
-    // backend renders.
+    // backend renders. Not "overhead": with the light straight down every wall is
+    // edge-on to it, and there the two references themselves (volumes and rays)
+    // disagree on 0.29% of the pixels, which a technique's rate inherits.
     let mut checked = 0;
-    for name in ["overhead", "facing_spot", "point_mid"] {
+    for name in ["behind", "facing_spot", "point_mid"] {
         checked += misclassification_gaps(&ctx, &configuration(name));
     }
     assert!(checked >= 12, "only {checked} techniques compared");
