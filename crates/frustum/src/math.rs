@@ -85,3 +85,25 @@ pub fn atan2(y: f64, x: f64) -> f64 {
 pub fn acos_clamped(x: f64) -> f64 {
     acos(x.clamp(-1.0, 1.0))
 }
+
+/// The smaller singular value of the 2x2 matrix with columns `a` and `b`: how much
+/// the map stretches the direction it stretches least (the texels per pixel of
+/// Lloyd et al.'s aliasing error, whose inverse is the error).
+///
+/// ```text
+/// F = |a|² + |b|²,  D = det[a b],  s_min² = (F - sqrt(F² - 4D²)) / 2 = 2D² / (F + sqrt(F² - 4D²))
+/// ```
+///
+/// computed in the second, cancellation-free form; 0 for the zero matrix.
+#[must_use]
+pub fn smaller_singular_value(a: glam::DVec2, b: glam::DVec2) -> f64 {
+    let frobenius = a.length_squared() + b.length_squared();
+    let det = a.perp_dot(b);
+    let root = sqrt((frobenius * frobenius - 4.0 * det * det).max(0.0));
+    let denom = frobenius + root;
+    if denom > 0.0 {
+        sqrt(2.0 * det * det / denom)
+    } else {
+        0.0
+    }
+}

@@ -356,7 +356,7 @@ impl Screen {
             }
             *column = (ends[0] - ends[1]) * 0.5;
         }
-        let m = 1.0 / smaller_singular_value(columns[0], columns[1]);
+        let m = 1.0 / math::smaller_singular_value(columns[0], columns[1]);
         (m.is_finite() && m > 0.0).then_some(m)
     }
 }
@@ -412,20 +412,6 @@ fn plane_hit(origin: DVec3, dir: DVec3, point: DVec3, normal: DVec3) -> Option<D
     let s = normal.dot(point - origin) / denom;
     let p = origin + dir * s;
     p.is_finite().then_some(p)
-}
-
-/// The smaller singular value of the 2x2 matrix with columns `a`, `b`.
-fn smaller_singular_value(a: DVec2, b: DVec2) -> f64 {
-    let frobenius = a.length_squared() + b.length_squared();
-    let det = a.perp_dot(b);
-    let root = math::sqrt((frobenius * frobenius - 4.0 * det * det).max(0.0));
-    // s_min² = (F - root) / 2 = 2 det² / (F + root), the stable form.
-    let denom = frobenius + root;
-    if denom > 0.0 {
-        math::sqrt(2.0 * det * det / denom)
-    } else {
-        0.0
-    }
 }
 
 /// Chooses among candidate techniques by predicted error, with hysteresis: the current

@@ -138,7 +138,7 @@ impl Probe {
                 let dh = *clip_from_world * d.extend(0.0);
                 (DVec2::new(dh.x, dh.y) * h.w - DVec2::new(h.x, h.y) * dh.w) / (h.w * h.w)
             };
-            let s = smaller_singular_value(ndc(q.dx), ndc(q.dy));
+            let s = math::smaller_singular_value(ndc(q.dx), ndc(q.dy));
             if !(s > 0.0) {
                 return f64::INFINITY;
             }
@@ -315,19 +315,6 @@ fn pow8(x: f64) -> f64 {
     let x2 = x * x;
     let x4 = x2 * x2;
     x4 * x4
-}
-
-/// The smaller singular value of the 2x2 matrix with columns `a`, `b`.
-fn smaller_singular_value(a: DVec2, b: DVec2) -> f64 {
-    let frobenius = a.length_squared() + b.length_squared();
-    let det = a.perp_dot(b);
-    let root = math::sqrt((frobenius * frobenius - 4.0 * det * det).max(0.0));
-    let denom = frobenius + root;
-    if denom > 0.0 {
-        math::sqrt(2.0 * det * det / denom)
-    } else {
-        0.0
-    }
 }
 
 /// Strengths at which a warp is evaluated, as fractions of its formula's warp in
