@@ -309,8 +309,11 @@ proptest! {
         };
         let p = inside + away * (10.0 + beyond);
         prop_assert!(ray_shadowed(&soup, &light, p));
-        let winding = -crossings(v.closed(), origin, p, p + DVec3::new(0.31, 0.83, -0.46) * 1e3);
-        prop_assert!(winding > 0);
+        // Counted along two rays: one that grazes a volume edge can miss or double a
+        // crossing, and two rarely both do.
+        let winding = [DVec3::new(0.31, 0.83, -0.46), DVec3::new(-0.72, 0.29, 0.63)]
+            .map(|d| -crossings(v.closed(), origin, p, p + d * 1e3));
+        prop_assert!(winding.iter().any(|w| *w > 0), "windings {:?}", winding);
     }
 }
 
