@@ -4,6 +4,9 @@
 // then each row and column of the map collapses to its maximum (WarpMaps::build).
 //
 //   importance = (reference_distance / max(d, min_distance))^distance_exponent
+//              * w                                              (the base's footprint:
+//                                   1 for an orthographic base, the light depth for a
+//                                   perspective one)
 //              * (1 + orientation_weight * (1 - |n . l|))      (normal given)
 //              * edge_weight                                    (sample on a shadow edge)
 //
@@ -92,6 +95,7 @@ fn splat_texel(texel: vec2<u32>) -> u32 {
     if params.distance.z != 1.0 {
         importance = pow(ratio, params.distance.z);
     }
+    importance *= h.w;
     let n = normalize_or_zero(normal_flags.xyz);
     if any(n != vec3<f32>(0.0)) {
         let cos_light = min(abs(dot(n, toward_light(position_distance.xyz))), 1.0);
