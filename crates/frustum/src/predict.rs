@@ -109,7 +109,8 @@ impl PredictOptions {
             && rays > 0
             && rays <= MAX_PREDICT_RAYS as u64
             && self.percentile > 0.0
-            && self.percentile <= 1.0;
+            && self.percentile <= 1.0
+            && self.light_direction.is_none_or(|d| d.is_finite());
         if ok {
             Ok(())
         } else {
@@ -186,7 +187,10 @@ pub fn predict_errors(
         return Err(FrustumError::EmptyBounds);
     }
     let screen = Screen::new(camera, options.viewport_height)?;
-    let toward_light = options.light_direction.map(|d| -d.as_dvec3());
+    let toward_light = options
+        .light_direction
+        .and_then(Vec3::try_normalize)
+        .map(|d| -d.as_dvec3());
     let mut errors = [[0.0f64; MAX_PREDICT_RAYS]; MAX_PREDICT_CANDIDATES];
     let mut counts = [0usize; MAX_PREDICT_CANDIDATES];
     // Front-lit shared rays first (without a light: every shared ray, twice); then

@@ -78,6 +78,7 @@ struct PredictOptionsDef {
     grid_columns: u32,
     grid_rows: u32,
     percentile: f64,
+    light_direction: Option<Vec3>,
 }
 
 crate::__deserialize_checked!(

@@ -167,6 +167,7 @@ fn predictions_round_trip() {
     let set = CascadeSet::fit(&camera, Vec3::NEG_Y, &splits, &CascadeOptions::default()).unwrap();
     let options = PredictOptions::new().with_grid(8, 4).with_percentile(0.9);
     round_trip(&options);
+    round_trip(&options.with_light_direction(Vec3::new(0.3, -1.0, 0.2)));
     let predicted = predict_error(
         &camera,
         &receivers,
