@@ -110,7 +110,7 @@ impl PredictOptions {
             && rays <= MAX_PREDICT_RAYS as u64
             && self.percentile > 0.0
             && self.percentile <= 1.0
-            && self.light_direction.is_none_or(|d| d.is_finite());
+            && self.light_direction.is_none_or(Vec3::is_finite);
         if ok {
             Ok(())
         } else {

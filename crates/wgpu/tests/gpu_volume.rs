@@ -404,3 +404,53 @@ fn gpu_silhouette_is_the_cpu_silhouette() {
         assert_eq!(found, expected, "{name}");
     }
 }
+
+/// One renderer kept across frames (its attachments, uniform and vertex buffers are
+/// reused) renders what a fresh renderer renders, when the scene, the light, the size
+/// and the method change between frames and when a frame repeats.
+#[test]
+fn a_reused_volume_renderer_renders_what_a_fresh_one_does() {
+    let Some(ctx) = shadowmap_wgpu::context::test_context(
+        "a_reused_volume_renderer_renders_what_a_fresh_one_does",
+    ) else {
+        return;
+    };
+    let (city, room) = (configuration("behind"), configuration("point_inside"));
+    let mut scenes =
+        [city.clone(), room.clone()].map(|c| VolumeScene::new(&triangles(&c.scene)).unwrap());
+    let mut reused = VolumeRenderer::new();
+    let frames = [
+        (0, &city, (W, H), VolumeMethod::ZPass),
+        (1, &room, (W, H), VolumeMethod::ZFail),
+        (1, &room, (W, H), VolumeMethod::ZFail),
+        (0, &city, (W / 2, H / 3), VolumeMethod::ZFail),
+        (0, &city, (W, H), VolumeMethod::ZPass),
+    ];
+    for (scene, config, size, method) in frames {
+        let mut render = |renderer: &mut VolumeRenderer| {
+            renderer
+                .render_mask(
+                    &ctx,
+                    &mut scenes[scene],
+                    config.camera(),
+                    &config.light,
+                    size,
+                    method,
+                )
+                .unwrap()
+        };
+        let fresh = render(&mut VolumeRenderer::new());
+        let kept = render(&mut reused);
+        assert_eq!((kept.width, kept.height), size);
+        assert!(
+            kept.values.contains(&MaskValue::Shadowed),
+            "{}: no shadow",
+            config.name
+        );
+        assert!(
+            kept == fresh,
+            "{} {size:?} {method:?}: the reused renderer differs",
+            config.name
+        );
+    }
+}

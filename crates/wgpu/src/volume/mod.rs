@@ -33,17 +33,20 @@
 //! [`crate::render::HeadlessRenderer`] with the volumes' mask pixel by pixel.
 
 mod compare;
+mod frame;
 mod pipelines;
 mod projective;
 mod silhouette;
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use glam::{Vec3, Vec4};
 use shadowmap_frustum::{Camera, Light};
 use shadowmap_volume::{EdgeMesh, Partition, ShadowVolume, VolumeError, infinite_clip_from_world};
-use wgpu::util::DeviceExt;
 
 pub use self::compare::{Misclassification, misclassification};
-use self::pipelines::{CLASS_FORMAT, DEPTH_STENCIL_FORMAT, VolumeFrameRaw, VolumePipelines};
+use self::frame::{FrameBuffers, FrameResources, Targets};
+use self::pipelines::{VolumeFrameRaw, VolumePipelines};
 pub use self::projective::ProjectiveRenderer;
 pub use self::silhouette::GpuSilhouette;
 use crate::render::{MaskValue, ShadowMask};
@@ -64,12 +67,17 @@ pub enum VolumeMethod {
 /// their edge adjacency (built once).
 #[derive(Clone, Debug)]
 pub struct VolumeScene {
+    /// Tells scenes apart, so a renderer uploads a scene's surfaces once.
+    id: u64,
     surfaces: Vec<Vec4>,
     casters: EdgeMesh,
     open_triangles: usize,
     first_open_edge: Option<VolumeError>,
     volume: ShadowVolume,
 }
+
+/// The id of the next [`VolumeScene`].
+static NEXT_SCENE_ID: AtomicU64 = AtomicU64::new(0);
 
 fn volume_error(e: VolumeError) -> BackendError {
     BackendError::InvalidInput(match e {
@@ -101,6 +109,7 @@ impl VolumeScene {
         let part = Partition::new(&positions, &indices).map_err(volume_error)?;
         let casters = EdgeMesh::new(&positions, &part.closed).map_err(volume_error)?;
         Ok(Self {
+            id: NEXT_SCENE_ID.fetch_add(1, Ordering::Relaxed),
             surfaces: positions.iter().map(|p| p.extend(1.0)).collect(),
             casters,
             open_triangles: part.open.len(),
@@ -135,57 +144,23 @@ impl VolumeScene {
     }
 }
 
-/// Renders shadow-volume masks; caches its pipelines across frames.
+/// Renders shadow-volume masks. Keeps its pipelines, attachments, uniform and
+/// vertex buffers across frames (see [`VolumeRenderer::render_mask`]), all on the
+/// device of its first frame.
 #[derive(Debug, Default)]
 pub struct VolumeRenderer {
     pipelines: Option<VolumePipelines>,
-}
-
-/// The frame's attachments.
-struct Targets {
-    class: wgpu::Texture,
-    depth: wgpu::Texture,
-}
-
-impl Targets {
-    fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
-        let target = |format, usage, label| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        Self {
-            class: target(
-                CLASS_FORMAT,
-                attach | wgpu::TextureUsages::COPY_SRC,
-                "shadowmap volume classes",
-            ),
-            depth: target(
-                DEPTH_STENCIL_FORMAT,
-                attach,
-                "shadowmap volume depth-stencil",
-            ),
-        }
-    }
+    frame: Option<FrameResources>,
 }
 
 impl VolumeRenderer {
     /// A renderer with no pipelines yet.
     #[must_use]
     pub const fn new() -> Self {
-        Self { pipelines: None }
+        Self {
+            pipelines: None,
+            frame: None,
+        }
     }
 
     /// The shadow-volume mask of `scene` lit by `light`, seen by `camera`, at
@@ -193,6 +168,10 @@ impl VolumeRenderer {
     /// [`MaskValue::Shadowed`] where a surface is seen within the camera's depth
     /// range, [`MaskValue::Background`] elsewhere. Spot lights shadow like point
     /// lights (visibility only, the cone does not darken).
+    ///
+    /// Frame after frame at one size, the only uploads are the frame uniform and the
+    /// volume geometry (into buffers that grow by doubling); the scene's surfaces are
+    /// uploaded when the scene changes, the attachments made when the size changes.
     ///
     /// # Errors
     /// [`BackendError::InvalidInput`] for a size of zero or past the device's
@@ -232,20 +211,22 @@ impl VolumeRenderer {
             let pipelines = self
                 .pipelines
                 .get_or_insert_with(|| VolumePipelines::new(&ctx.device));
-            let targets = Targets::new(&ctx.device, width, height);
+            let resources = self
+                .frame
+                .get_or_insert_with(|| FrameResources::new(&ctx.device, pipelines));
+            let (targets, buffers) = resources.prepare(
+                (&ctx.device, &ctx.queue),
+                (width, height),
+                &frame,
+                (scene.id, &scene.surfaces),
+                volume,
+            );
             let mut encoder = ctx
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some("shadowmap volumes"),
                 });
-            record(
-                ctx,
-                pipelines,
-                &mut encoder,
-                &targets,
-                &frame,
-                (&scene.surfaces, volume, method),
-            );
+            record(pipelines, &mut encoder, targets, buffers, method);
             ctx.queue.submit([encoder.finish()]);
             let classes = ctx.read_texture(&targets.class, wgpu::TextureAspect::All)?;
             Ok(decode(width, height, &classes))
@@ -253,48 +234,19 @@ impl VolumeRenderer {
     }
 }
 
-fn vertex_buffer(ctx: &GpuContext, label: &str, vertices: &[Vec4]) -> Option<wgpu::Buffer> {
-    (!vertices.is_empty()).then(|| {
-        ctx.device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: bytemuck::cast_slice(vertices),
-                usage: wgpu::BufferUsages::VERTEX,
-            })
-    })
-}
-
 /// Records the surface, volume and classification passes.
 fn record(
-    ctx: &GpuContext,
     pipelines: &VolumePipelines,
     encoder: &mut wgpu::CommandEncoder,
     targets: &Targets,
-    frame: &VolumeFrameRaw,
-    (surfaces, volume, method): (&[Vec4], &[Vec4], VolumeMethod),
+    buffers: &FrameBuffers,
+    method: VolumeMethod,
 ) {
-    let uniform = ctx
-        .device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("shadowmap volume frame"),
-            contents: bytemuck::bytes_of(frame),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-    let group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("shadowmap volume frame"),
-        layout: &pipelines.layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: uniform.as_entire_binding(),
-        }],
-    });
-    let surfaces = vertex_buffer(ctx, "shadowmap volume surfaces", surfaces);
-    let volume_buffer = vertex_buffer(ctx, "shadowmap volume geometry", volume);
-    let class_view = targets.class.create_view(&Default::default());
-    let depth_view = targets.depth.create_view(&Default::default());
+    let (class_view, depth_view, group) =
+        (&targets.class_view, &targets.depth_view, &buffers.group);
     let color = |ops| {
         [Some(wgpu::RenderPassColorAttachment {
-            view: &class_view,
+            view: class_view,
             depth_slice: None,
             resolve_target: None,
             ops,
@@ -309,39 +261,39 @@ fn record(
             encoder,
             "shadowmap volume surfaces",
             &colors,
-            (&depth_view, clear(0.0), clear(0)),
+            (depth_view, clear(0.0), clear(0)),
         );
-        if let Some(buffer) = &surfaces {
+        if let Some((slice, vertices)) = buffers.surfaces.drawable() {
             p.set_pipeline(&pipelines.surface);
-            p.set_bind_group(0, &group, &[]);
-            p.set_vertex_buffer(0, buffer.slice(..));
-            p.draw(0..(buffer.size() / 16) as u32, 0..1);
+            p.set_bind_group(0, group, &[]);
+            p.set_vertex_buffer(0, slice);
+            p.draw(0..vertices, 0..1);
         }
     }
-    if let Some(buffer) = &volume_buffer {
+    if let Some((slice, vertices)) = buffers.volume.drawable() {
         let mut p = begin(
             encoder,
             "shadowmap volume stencil",
             &[],
-            (&depth_view, load(), load()),
+            (depth_view, load(), load()),
         );
         p.set_pipeline(match method {
             VolumeMethod::ZPass => &pipelines.z_pass,
             VolumeMethod::ZFail => &pipelines.z_fail,
         });
-        p.set_bind_group(0, &group, &[]);
-        p.set_vertex_buffer(0, buffer.slice(..));
-        p.draw(0..(buffer.size() / 16) as u32, 0..1);
+        p.set_bind_group(0, group, &[]);
+        p.set_vertex_buffer(0, slice);
+        p.draw(0..vertices, 0..1);
     }
     let colors = color(load());
     let mut p = begin(
         encoder,
         "shadowmap volume classify",
         &colors,
-        (&depth_view, load(), load()),
+        (depth_view, load(), load()),
     );
     p.set_pipeline(&pipelines.classify);
-    p.set_bind_group(0, &group, &[]);
+    p.set_bind_group(0, group, &[]);
     p.set_stencil_reference(0);
     p.draw(0..3, 0..1);
 }

@@ -21,14 +21,16 @@ struct LightRaw {
     counts: [u32; 4],
 }
 
-/// A closed mesh uploaded once, and the pipeline that finds its silhouette.
+/// A closed mesh uploaded once, the pipeline that finds its silhouette, and the
+/// light uniform and output buffers that every [`GpuSilhouette::find`] rewrites in
+/// place (a call allocates nothing on the GPU).
 #[derive(Debug)]
 pub struct GpuSilhouette {
     pipeline: wgpu::ComputePipeline,
-    layout: wgpu::BindGroupLayout,
-    positions: wgpu::Buffer,
-    triangles: wgpu::Buffer,
-    edges: wgpu::Buffer,
+    group: wgpu::BindGroup,
+    light: wgpu::Buffer,
+    found: wgpu::Buffer,
+    silhouette: wgpu::Buffer,
     edge_count: u32,
 }
 
@@ -45,8 +47,82 @@ fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
+/// The bind group layout and the pipeline of `find_silhouette`.
+fn pipeline(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::ComputePipeline) {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("shadowmap volume_silhouette"),
+        source: wgpu::ShaderSource::Wgsl(shaders::VOLUME_SILHOUETTE.into()),
+    });
+    let light = wgpu::BindGroupLayoutEntry {
+        binding: 0,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: NonZeroU64::new(size_of::<LightRaw>() as u64),
+        },
+        count: None,
+    };
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("shadowmap silhouette"),
+        entries: &[
+            light,
+            storage(1, true),
+            storage(2, true),
+            storage(3, true),
+            storage(4, false),
+            storage(5, false),
+        ],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("shadowmap silhouette"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("shadowmap silhouette"),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some("find_silhouette"),
+        compilation_options: wgpu::PipelineCompilationOptions::default(),
+        cache: None,
+    });
+    (layout, pipeline)
+}
+
+/// The mesh as the shader reads it, each element padded to 16 bytes.
+struct MeshArrays {
+    positions: Vec<[f32; 4]>,
+    triangles: Vec<[u32; 4]>,
+    edges: Vec<[u32; 4]>,
+}
+
+fn mesh_arrays(mesh: &EdgeMesh) -> MeshArrays {
+    let positions = mesh
+        .positions
+        .iter()
+        .map(|p| p.as_vec3().extend(1.0).to_array())
+        .collect();
+    let triangles = mesh
+        .triangles
+        .iter()
+        .map(|t| [t[0], t[1], t[2], 0])
+        .collect();
+    let edges = mesh
+        .edges
+        .iter()
+        .map(|e| [e.vertices[0], e.vertices[1], e.triangles[0], e.triangles[1]])
+        .collect();
+    MeshArrays {
+        positions,
+        triangles,
+        edges,
+    }
+}
+
 impl GpuSilhouette {
-    /// Uploads the mesh's welded positions, triangles and edges.
+    /// Uploads the mesh's welded positions, triangles and edges, and makes the
+    /// buffers that [`find`](Self::find) reuses.
     ///
     /// # Errors
     /// [`BackendError::InvalidInput`] for more edges than one dispatch covers;
@@ -61,7 +137,7 @@ impl GpuSilhouette {
             ))?;
         ctx.scoped(|ctx| {
             let device = &ctx.device;
-            let upload = |label, contents: &[u8]| {
+            let buffer = |label, contents: &[u8], usage| {
                 device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some(label),
                     // One element at least: empty storage bindings are invalid.
@@ -70,73 +146,73 @@ impl GpuSilhouette {
                     } else {
                         contents
                     },
-                    usage: wgpu::BufferUsages::STORAGE,
+                    usage,
                 })
             };
-            let positions: Vec<[f32; 4]> = mesh
-                .positions
-                .iter()
-                .map(|p| p.as_vec3().extend(1.0).to_array())
-                .collect();
-            let triangles: Vec<[u32; 4]> = mesh
-                .triangles
-                .iter()
-                .map(|t| [t[0], t[1], t[2], 0])
-                .collect();
-            let edges: Vec<[u32; 4]> = mesh
-                .edges
-                .iter()
-                .map(|e| [e.vertices[0], e.vertices[1], e.triangles[0], e.triangles[1]])
-                .collect();
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("shadowmap volume_silhouette"),
-                source: wgpu::ShaderSource::Wgsl(shaders::VOLUME_SILHOUETTE.into()),
+            let read = wgpu::BufferUsages::STORAGE;
+            let written = read | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+            let MeshArrays {
+                positions,
+                triangles,
+                edges,
+            } = mesh_arrays(mesh);
+            let inputs = [
+                buffer(
+                    "shadowmap silhouette positions",
+                    bytemuck::cast_slice(&positions),
+                    read,
+                ),
+                buffer(
+                    "shadowmap silhouette triangles",
+                    bytemuck::cast_slice(&triangles),
+                    read,
+                ),
+                buffer(
+                    "shadowmap silhouette edges",
+                    bytemuck::cast_slice(&edges),
+                    read,
+                ),
+            ];
+            let light = buffer(
+                "shadowmap silhouette light",
+                bytemuck::bytes_of(&LightRaw::zeroed()),
+                wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            );
+            let found = buffer("shadowmap silhouette count", &[0; 4], written);
+            let silhouette = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("shadowmap silhouette edges found"),
+                size: 8 * u64::from(edge_count.max(1)),
+                usage: written,
+                mapped_at_creation: false,
             });
-            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            let (layout, pipeline) = pipeline(device);
+            let bound = [
+                &light,
+                &inputs[0],
+                &inputs[1],
+                &inputs[2],
+                &found,
+                &silhouette,
+            ];
+            let entries: Vec<wgpu::BindGroupEntry<'_>> = bound
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("shadowmap silhouette"),
-                entries: &[
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 0,
-                        visibility: wgpu::ShaderStages::COMPUTE,
-                        ty: wgpu::BindingType::Buffer {
-                            ty: wgpu::BufferBindingType::Uniform,
-                            has_dynamic_offset: false,
-                            min_binding_size: NonZeroU64::new(size_of::<LightRaw>() as u64),
-                        },
-                        count: None,
-                    },
-                    storage(1, true),
-                    storage(2, true),
-                    storage(3, true),
-                    storage(4, false),
-                    storage(5, false),
-                ],
-            });
-            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("shadowmap silhouette"),
-                bind_group_layouts: &[Some(&layout)],
-                immediate_size: 0,
-            });
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("shadowmap silhouette"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some("find_silhouette"),
-                compilation_options: wgpu::PipelineCompilationOptions::default(),
-                cache: None,
+                layout: &layout,
+                entries: &entries,
             });
             Ok(Self {
                 pipeline,
-                layout,
-                positions: upload(
-                    "shadowmap silhouette positions",
-                    bytemuck::cast_slice(&positions),
-                ),
-                triangles: upload(
-                    "shadowmap silhouette triangles",
-                    bytemuck::cast_slice(&triangles),
-                ),
-                edges: upload("shadowmap silhouette edges", bytemuck::cast_slice(&edges)),
+                group,
+                light,
+                found,
+                silhouette,
                 edge_count,
             })
         })
@@ -163,54 +239,20 @@ impl GpuSilhouette {
         };
         ctx.scoped(|ctx| {
             let device = &ctx.device;
-            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("shadowmap silhouette light"),
-                contents: bytemuck::bytes_of(&raw),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let out_usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-            let found = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("shadowmap silhouette count"),
-                contents: &[0; 4],
-                usage: out_usage,
-            });
-            let silhouette = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shadowmap silhouette edges found"),
-                size: 8 * u64::from(self.edge_count.max(1)),
-                usage: out_usage,
-                mapped_at_creation: false,
-            });
-            let buffers = [
-                &uniform,
-                &self.positions,
-                &self.triangles,
-                &self.edges,
-                &found,
-                &silhouette,
-            ];
-            let entries: Vec<wgpu::BindGroupEntry<'_>> = buffers
-                .iter()
-                .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry {
-                    binding: i as u32,
-                    resource: b.as_entire_binding(),
-                })
-                .collect();
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("shadowmap silhouette"),
-                layout: &self.layout,
-                entries: &entries,
-            });
+            ctx.queue
+                .write_buffer(&self.light, 0, bytemuck::bytes_of(&raw));
+            ctx.queue.write_buffer(&self.found, 0, &[0; 4]);
             let mut encoder = device.create_command_encoder(&Default::default());
             {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
                 pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &group, &[]);
+                pass.set_bind_group(0, &self.group, &[]);
                 pass.dispatch_workgroups(self.edge_count.div_ceil(WORKGROUP), 1, 1);
             }
             ctx.queue.submit([encoder.finish()]);
-            let count: u32 = bytemuck::pod_read_unaligned(&ctx.read_buffer(&found)?);
-            let edges: Vec<[u32; 2]> = bytemuck::pod_collect_to_vec(&ctx.read_buffer(&silhouette)?);
+            let count: u32 = bytemuck::pod_read_unaligned(&ctx.read_buffer(&self.found)?);
+            let edges: Vec<[u32; 2]> =
+                bytemuck::pod_collect_to_vec(&ctx.read_buffer(&self.silhouette)?);
             Ok(edges[..(count as usize).min(edges.len())].to_vec())
         })
     }
