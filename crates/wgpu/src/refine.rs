@@ -39,6 +39,7 @@ use glam::Vec3;
 use shadowmap_rtw::RtwSubdivision;
 
 use crate::depth::{DepthUniforms, rtw_table_texels, table_buffer};
+use crate::uniforms::RtwShadowRaw;
 use crate::{BackendError, GpuContext, compose};
 
 /// Deepest refinement the pass supports: `max_segments` up to 1024, as
@@ -227,27 +228,7 @@ impl GpuRefine {
         );
         let tables = table_buffer(device, 4);
         let layout = bind_group_layout(device);
-        let source = compose::rtw_refine()?;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("shadowmap rtw refine"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("shadowmap rtw refine"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let (count, choose, emit) = (pipeline("count"), pipeline("choose"), pipeline("emit"));
+        let [count, choose, emit] = pipelines(device, &layout)?;
         let bind_group = make_bind_group(
             device,
             &layout,
@@ -320,33 +301,7 @@ impl GpuRefine {
         encoder: &mut wgpu::CommandEncoder,
         uniforms: &DepthUniforms<'_>,
     ) -> Result<(), BackendError> {
-        let raw = match uniforms {
-            DepthUniforms::Rtw { raw, tables } => {
-                if tables.len() < rtw_table_texels(raw).max(1) {
-                    return Err(BackendError::InvalidInput(
-                        "RTW tables shorter than their sizes",
-                    ));
-                }
-                let bytes: &[u8] = bytemuck::cast_slice(tables);
-                self.grow_tables(ctx, bytes.len() as u64);
-                ctx.queue.write_buffer(&self.tables, 0, bytes);
-                raw
-            }
-            DepthUniforms::RtwGpuTables { raw, tables } => {
-                let bytes = (rtw_table_texels(raw).max(1) * 4) as u64;
-                if tables.size() < bytes || !tables.usage().contains(wgpu::BufferUsages::COPY_SRC) {
-                    return Err(BackendError::InvalidInput(
-                        "RTW table buffer shorter than its sizes or without COPY_SRC",
-                    ));
-                }
-                self.grow_tables(ctx, bytes);
-                encoder.copy_buffer_to_buffer(tables, 0, &self.tables, 0, bytes);
-                raw
-            }
-            DepthUniforms::Matrix(_) | DepthUniforms::Paraboloid(_) => {
-                return Err(BackendError::InvalidInput("refine: uniforms are not RTW's"));
-            }
-        };
+        let raw = self.upload_tables(ctx, encoder, uniforms)?;
         let rule = self
             .options
             .subdivision
@@ -378,6 +333,43 @@ impl GpuRefine {
         pass.set_pipeline(&self.emit);
         pass.dispatch_workgroups(groups, 1, 1);
         Ok(())
+    }
+
+    /// Brings the RTW tables of `uniforms` into the pass's table buffer (queued from
+    /// a slice, copied inside `encoder` from a GPU buffer) and returns their block.
+    fn upload_tables<'u>(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        uniforms: &'u DepthUniforms<'_>,
+    ) -> Result<&'u RtwShadowRaw, BackendError> {
+        match uniforms {
+            DepthUniforms::Rtw { raw, tables } => {
+                if tables.len() < rtw_table_texels(raw).max(1) {
+                    return Err(BackendError::InvalidInput(
+                        "RTW tables shorter than their sizes",
+                    ));
+                }
+                let bytes: &[u8] = bytemuck::cast_slice(tables);
+                self.grow_tables(ctx, bytes.len() as u64);
+                ctx.queue.write_buffer(&self.tables, 0, bytes);
+                Ok(raw)
+            }
+            DepthUniforms::RtwGpuTables { raw, tables } => {
+                let bytes = (rtw_table_texels(raw).max(1) * 4) as u64;
+                if tables.size() < bytes || !tables.usage().contains(wgpu::BufferUsages::COPY_SRC) {
+                    return Err(BackendError::InvalidInput(
+                        "RTW table buffer shorter than its sizes or without COPY_SRC",
+                    ));
+                }
+                self.grow_tables(ctx, bytes);
+                encoder.copy_buffer_to_buffer(tables, 0, &self.tables, 0, bytes);
+                Ok(raw)
+            }
+            DepthUniforms::Matrix(_) | DepthUniforms::Paraboloid(_) => {
+                Err(BackendError::InvalidInput("refine: uniforms are not RTW's"))
+            }
+        }
     }
 
     /// Reads the stats of the last submitted refinement. Blocks until the GPU is
@@ -438,6 +430,34 @@ impl GpuRefine {
             );
         }
     }
+}
+
+/// The `count`, `choose` and `emit` pipelines of `rtw_refine.wgsl` (its table
+/// sampler composed in) over `layout`.
+fn pipelines(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+) -> Result<[wgpu::ComputePipeline; 3], BackendError> {
+    let source = compose::rtw_refine()?;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("shadowmap rtw refine"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("shadowmap rtw refine"),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    Ok(["count", "choose", "emit"].map(|entry| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    }))
 }
 
 /// Binding 0 the parameters, 1 the tables, 2 the casters (read-only), 3 the state,
