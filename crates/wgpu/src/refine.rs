@@ -514,3 +514,35 @@ fn make_bind_group(
         entries: &entries,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `RefineParamsRaw` has the span naga computes for WGSL `RefineParams`, and the
+    /// shader's limits are this module's.
+    #[test]
+    fn params_and_limits_match_the_shader() {
+        let source = compose::rtw_refine().unwrap();
+        let module = naga::front::wgsl::parse_str(&source).expect("parses");
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).expect("layout");
+        let span = module
+            .types
+            .iter()
+            .find(|(_, ty)| ty.name.as_deref() == Some("RefineParams"))
+            .map(|(handle, _)| layouter[handle].size)
+            .expect("RefineParams");
+        assert_eq!(span as usize, size_of::<RefineParamsRaw>());
+        for (name, value) in [
+            ("MAX_LEVELS", u64::from(MAX_LEVELS)),
+            ("CAPS", CAPS),
+            ("CHOSEN", STATS_WORD as u64),
+        ] {
+            let line = format!("const {name}: u32 = {value}u;");
+            assert!(source.contains(&line), "shader lacks `{line}`");
+        }
+        assert!(source.contains(&format!("array<atomic<u32>, {STATE_WORDS}>")));
+        assert!(source.contains(&format!("@workgroup_size({WORKGROUP})")));
+    }
+}
