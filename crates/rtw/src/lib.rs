@@ -150,7 +150,7 @@ pub use importance::{
     AccumulateStats, BasePoint, EyeSample, ImportanceMap, ImportanceOptions, MAX_MAP_CELLS,
     MAX_MAP_SIDE, OracleAxis,
 };
-pub use subdivide::{RtwSubdivision, subdivide_for_rtw, subdivide_for_rtw_with};
+pub use subdivide::{RtwSplitRule, RtwSubdivision, subdivide_for_rtw, subdivide_for_rtw_with};
 pub use table::{
     forward_warp, forward_warp_f64, inverse_warp, inverse_warp_f64, sample_table, sample_table_f64,
 };

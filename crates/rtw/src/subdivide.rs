@@ -8,7 +8,9 @@
 //! split of an edge depends on its two endpoints alone, so shared edges split alike and
 //! a conforming mesh stays conforming (no T-junctions, hence no cracks): the same
 //! property as the paraboloid subdivision of `shadowmap-paraboloid`. Both the CPU
-//! reference rasterizer and the GPU depth pass render the mesh this function returns.
+//! reference rasterizer and the GPU depth pass render the mesh this function returns;
+//! the compute refinement of `shadowmap-wgpu` is its twin on the GPU (the same rule,
+//! [`RtwSubdivision::split_rule`], and the same pieces, evaluated in `f32`).
 
 use alloc::vec::Vec;
 
@@ -80,6 +82,52 @@ impl RtwSubdivision {
     }
 }
 
+/// The numbers the split rule of [`subdivide_for_rtw`] runs on, its options clamped
+/// to their documented ranges: what a GPU twin of the subdivision (the compute
+/// refinement of `shadowmap-wgpu`) needs to decide exactly as the CPU does.
+///
+/// ```text
+/// split edge a b  <=>  max(|du| pieces.x, |dv| pieces.y) > 1
+///                  or  max|W(uv(mid)) - (W(uv(a)) + W(uv(b))) / 2| * error_scale > 1
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RtwSplitRule {
+    /// Pieces per unit of base texture space along `u` and `v`: table texels over
+    /// the longest piece in cells.
+    pub pieces: DVec2,
+    /// Map texels over the error bound (warped-uv error times this above 1 splits).
+    pub error_scale: f64,
+    /// Halvings of an original edge, `ceil(log2(max_segments))`, in `0..=10`.
+    pub levels: u32,
+}
+
+impl RtwSubdivision {
+    /// The split rule for tables of `u_texels` and `v_texels` texels. Out-of-range
+    /// options are clamped (NaN: the default), as in [`subdivide_for_rtw`].
+    #[must_use]
+    pub fn split_rule(&self, u_texels: usize, v_texels: usize) -> RtwSplitRule {
+        let defaults = Self::default();
+        let at_least = |x: f64, default: f64| {
+            if x.is_nan() {
+                default
+            } else {
+                x.clamp(1.0 / 64.0, f64::MAX)
+            }
+        };
+        let max_span = at_least(self.max_span_cells, defaults.max_span_cells);
+        let max_error = at_least(self.max_error_texels, defaults.max_error_texels);
+        RtwSplitRule {
+            pieces: DVec2::new(u_texels as f64, v_texels as f64) / max_span,
+            error_scale: f64::from(self.resolution.max(1)) / max_error,
+            levels: self
+                .max_segments
+                .clamp(1, 1024)
+                .next_power_of_two()
+                .trailing_zeros(),
+        }
+    }
+}
+
 /// Splits triangles for the RTW depth pass, which warps only vertices: the warp is
 /// piecewise linear between the tables' texel centres, so a long edge stays straight
 /// where the warped map bends it. An edge is halved when it spans more than
@@ -121,27 +169,14 @@ pub fn subdivide_for_rtw_with(
     out: &mut Vec<[Vec3; 3]>,
 ) -> usize {
     out.clear();
-    let defaults = RtwSubdivision::default();
-    let at_least = |x: f64, default: f64| {
-        if x.is_nan() {
-            default
-        } else {
-            x.clamp(1.0 / 64.0, f64::MAX)
-        }
-    };
-    let max_span = at_least(options.max_span_cells, defaults.max_span_cells);
-    let max_error = at_least(options.max_error_texels, defaults.max_error_texels);
+    let rule = options.split_rule(warps.x_table().len(), warps.y_table().len());
     let splitter = RtwSplitter {
         base_uv,
         warps,
-        pieces: DVec2::new(warps.x_table().len() as f64, warps.y_table().len() as f64) / max_span,
-        error_scale: f64::from(options.resolution.max(1)) / max_error,
+        pieces: rule.pieces,
+        error_scale: rule.error_scale,
     };
-    let levels = options
-        .max_segments
-        .clamp(1, 1024)
-        .next_power_of_two()
-        .trailing_zeros();
+    let levels = rule.levels;
     for &t in triangles {
         if t.iter().all(|p| p.is_finite() && splitter.uv(*p).is_some()) {
             splitter.split(t, levels, out);

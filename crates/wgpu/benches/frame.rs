@@ -1,19 +1,25 @@
 //! Per-frame CPU work of the backend: packing the uniform blocks with `to_raw` for
 //! each technique, subdividing the casters of the city block for RTW, and recording
-//! depth passes (needs an adapter; skipped without one).
+//! depth passes (needs an adapter; skipped without one). `rtw_frame_cpu`: the CPU
+//! cost of a whole RTW frame with the tables built and the casters refined on the
+//! GPU.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use shadowmap::{DpsmOptions, FitInput, Fitted, Shadow, Technique, fit};
-use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds};
-use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
+use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds, ShadowTransform};
+use shadowmap_rtw::{
+    EyeSample, ImportanceMap, ImportanceOptions, RtwShadow, WarpMaps, WarpOptions,
+};
 use shadowmap_wgpu::GpuContext;
 use shadowmap_wgpu::depth::{
     DepthPassDesc, DepthTechnique, DepthUniforms, MeshBuffers, RtwSubdivision, ShadowDepthPass,
     subdivide_for_rtw,
 };
+use shadowmap_wgpu::refine::{GpuRefine, RefineOptions};
+use shadowmap_wgpu::rtw::{GpuRtw, RtwGBufferTextures};
 use shadowmap_wgpu::uniforms::{RtwShadowRaw, ToRaw, cascade_layers, paraboloid_layers};
 
 fn camera() -> Camera {
@@ -175,5 +181,129 @@ fn packing(c: &mut Criterion) {
     });
 }
 
+/// The city block's casters as a triangle soup.
+fn city_casters() -> Vec<[Vec3; 3]> {
+    shadowmap_eval::scene::Scene::city_block(1)
+        .mesh
+        .triangles()
+        .map(|t| t.map(glam::DVec3::as_vec3))
+        .collect()
+}
+
+/// A `width x height` G-buffer of the bench camera looking at the ground plane of
+/// the block (`y = 0`, `|x|, |z| <= 200`): one eye sample per pixel that hits it.
+fn ground_gbuffer(width: u32, height: u32) -> Vec<Option<EyeSample>> {
+    let cam = camera();
+    let world_from_clip = cam.clip_from_world().expect("camera").inverse();
+    let eye = cam.eye();
+    let pixel = |x: u32, y: u32| {
+        let ndc_x = 2.0 * (x as f32 + 0.5) / width as f32 - 1.0;
+        let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / height as f32;
+        let through = world_from_clip.project_point3(Vec3::new(ndc_x, ndc_y, 0.5));
+        let direction = through - eye;
+        let t = -eye.y / direction.y;
+        let hit = eye + direction * t;
+        (direction.y < 0.0 && hit.x.abs() <= 200.0 && hit.z.abs() <= 200.0).then(|| EyeSample {
+            position: hit,
+            normal: Vec3::Y,
+            eye_distance: hit.distance(eye),
+        })
+    };
+    (0..height)
+        .flat_map(|y| (0..width).map(move |x| pixel(x, y)))
+        .collect()
+}
+
+/// One RTW frame's GPU objects: the G-buffer, the table build, the refinement and
+/// the depth pass.
+struct RtwFrame {
+    gbuffer: RtwGBufferTextures,
+    rtw: GpuRtw,
+    refine: GpuRefine,
+    pass: ShadowDepthPass,
+    base: ShadowTransform,
+}
+
+impl RtwFrame {
+    /// Records the frame: tables, refinement, indirect depth pass.
+    fn record(&mut self, ctx: &GpuContext) -> (bool, wgpu::CommandBuffer) {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let recorded = self
+            .rtw
+            .encode(ctx, &mut encoder, &self.gbuffer.as_gbuffer(), &self.base)
+            .and_then(|()| {
+                let uniforms = self.rtw.depth_uniforms(&self.base);
+                self.refine.encode(ctx, &mut encoder, &uniforms)?;
+                self.pass
+                    .encode_refined(ctx, &mut encoder, &self.refine, &uniforms)
+            });
+        (recorded.is_ok(), encoder.finish())
+    }
+}
+
+/// CPU time to prepare and record one RTW frame of the city block into a 2048² map:
+/// importance, blur and 256-cell tables on the GPU ([`GpuRtw::encode`]), the casters
+/// refined on the GPU ([`GpuRefine::encode`]), the depth pass drawn indirectly
+/// ([`ShadowDepthPass::encode_refined`]), the command buffer finished and the frame's
+/// uploads flushed (`submit([])`). The frame's command buffer itself is not submitted:
+/// on a software adapter its execution is CPU rasterization, not CPU cost of the
+/// frame. No read-back. The G-buffer's size only changes a dispatch count.
+fn rtw_frame_cpu(c: &mut Criterion) {
+    let Ok(ctx) = GpuContext::new_headless() else {
+        eprintln!("rtw_frame_cpu: no adapter, not measured");
+        return;
+    };
+    let sun = Light::Directional {
+        direction: Vec3::new(0.4, -1.0, 0.3),
+    };
+    let base = *fit_bench(&Technique::UniformFocused(Default::default()), &sun, 4)
+        .transform()
+        .expect("uniform");
+    let (width, height) = (480, 270);
+    let casters = city_casters();
+    let options =
+        RefineOptions::default().with_subdivision(RtwSubdivision::default().with_resolution(2048));
+    let setup = ctx.scoped(|ctx| {
+        let samples = ground_gbuffer(width, height);
+        Ok(RtwFrame {
+            gbuffer: RtwGBufferTextures::from_samples(ctx, width, height, &samples, None)?,
+            rtw: GpuRtw::new(
+                ctx,
+                256,
+                256,
+                &WarpOptions::default(),
+                &ImportanceOptions::default(),
+            )?,
+            refine: GpuRefine::new(ctx, &casters, &options)?,
+            pass: ShadowDepthPass::new(ctx, &DepthPassDesc::new(DepthTechnique::Rtw, 2048))?,
+            base,
+        })
+    });
+    let mut frame = match setup {
+        Ok(frame) => frame,
+        Err(e) => {
+            eprintln!("rtw_frame_cpu: setup failed: {e}");
+            return;
+        }
+    };
+    // One frame run for real, to report what it draws.
+    let (ok, commands) = frame.record(&ctx);
+    ctx.queue.submit([commands]);
+    match frame.refine.read_stats(&ctx) {
+        Ok(stats) if ok => eprintln!("rtw_frame_cpu: {} casters -> {stats:?}", casters.len()),
+        other => eprintln!("rtw_frame_cpu: frame failed: {other:?}"),
+    }
+    let mut g = c.benchmark_group("rtw_frame_cpu");
+    g.bench_function("city_block_2048_tables_256_gpu_refine", |b| {
+        b.iter(|| {
+            let recorded = black_box(frame.record(&ctx));
+            ctx.queue.submit([]);
+            recorded.0
+        });
+    });
+    g.finish();
+}
+
 criterion_group!(benches, packing);
-criterion_main!(benches);
+criterion_group!(frame_cpu, rtw_frame_cpu);
+criterion_main!(benches, frame_cpu);

@@ -4,7 +4,8 @@
 //!
 //! - The scene shader (`render_scene.wgsl`) takes a lookup (`lookup_*.wgsl`) and a
 //!   filter (`filter_*.wgsl`): [`compose_scene_shader`].
-//! - RTW's depth pass (`depth_rtw.wgsl`) and lookup (`lookup_rtw.wgsl`) take the one
+//! - RTW's depth pass (`depth_rtw.wgsl`), caster refinement (`rtw_refine.wgsl`) and
+//!   lookup (`lookup_rtw.wgsl`) take the one
 //!   warp-table sampler of `rtw_sample.wgsl` ([`with_rtw_sample`]), which has the
 //!   semantics of `shadowmap_rtw::sample_table`.
 //!
@@ -49,6 +50,14 @@ pub fn depth_rtw() -> Result<String, BackendError> {
     with_rtw_sample(shaders::DEPTH_RTW)
 }
 
+/// RTW's caster refinement with the table sampler composed in.
+///
+/// # Errors
+/// As [`with_rtw_sample`].
+pub fn rtw_refine() -> Result<String, BackendError> {
+    with_rtw_sample(shaders::RTW_REFINE)
+}
+
 /// RTW's lookup with the table sampler composed in.
 ///
 /// # Errors
@@ -79,7 +88,8 @@ macro_rules! combos {
 
 /// Every source the backend composes at run time: each lookup with each filter,
 /// named `render_scene+LOOKUP+FILTER` (the RTW lookup with its table sampler), then
-/// RTW's depth pass, `depth_rtw+rtw_sample`; each with the composition's own result,
+/// RTW's depth pass, `depth_rtw+rtw_sample`, and its caster refinement,
+/// `rtw_refine+rtw_sample`; each with the composition's own result,
 /// so a failing one is reported by name rather than dropped (the naga test validates
 /// them all).
 #[must_use]
@@ -111,6 +121,7 @@ pub fn composed_shaders() -> Vec<(&'static str, Result<String, BackendError>)> {
         .map(|(name, l, f)| (*name, expand(l).and_then(|l| compose_scene_shader(&l, f))))
         .collect();
     out.push(("depth_rtw+rtw_sample", depth_rtw()));
+    out.push(("rtw_refine+rtw_sample", rtw_refine()));
     out
 }
 
@@ -142,7 +153,11 @@ mod tests {
 
     #[test]
     fn rtw_hosts_get_the_real_sampler_once() {
-        for source in [depth_rtw().unwrap(), lookup_rtw().unwrap()] {
+        for source in [
+            depth_rtw().unwrap(),
+            lookup_rtw().unwrap(),
+            rtw_refine().unwrap(),
+        ] {
             assert_eq!(source.matches("fn rtw_sample(").count(), 1);
             assert!(source.contains("rtw_tables[offset + i]"));
             assert!(!source.contains("// @compose"));

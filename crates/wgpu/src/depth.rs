@@ -437,6 +437,51 @@ impl ShadowDepthPass {
         meshes: &[&MeshBuffers],
         uniforms: &DepthUniforms<'_>,
     ) -> Result<(), BackendError> {
+        if !(meshes.len() == 1 || meshes.len() == self.desc.layers as usize) {
+            return Err(BackendError::InvalidInput(
+                "need one mesh, or one per layer",
+            ));
+        }
+        self.upload(ctx, encoder, uniforms)?;
+        self.record(encoder, meshes);
+        Ok(())
+    }
+
+    /// [`ShadowDepthPass::encode`] for casters refined on the GPU: uploads the RTW
+    /// uniforms as `encode` does and draws the refined triangles of `refined` with
+    /// `draw_indirect` (the count the refinement wrote). Record it after
+    /// [`crate::refine::GpuRefine::encode`], in the same or a later submission.
+    ///
+    /// # Errors
+    /// As [`ShadowDepthPass::encode`]; also [`BackendError::InvalidInput`] for a pass
+    /// that is not RTW's.
+    pub fn encode_refined(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        refined: &crate::refine::GpuRefine,
+        uniforms: &DepthUniforms<'_>,
+    ) -> Result<(), BackendError> {
+        if self.desc.technique != DepthTechnique::Rtw {
+            return Err(BackendError::InvalidInput(
+                "refined casters are drawn by the RTW pass",
+            ));
+        }
+        self.upload(ctx, encoder, uniforms)?;
+        let mut pass = self.begin_layer(encoder, 0);
+        pass.set_vertex_buffer(0, refined.vertices().slice(..));
+        pass.draw_indirect(refined.draw_buffer(), 0);
+        Ok(())
+    }
+
+    /// Checks `uniforms` against the pass, queues the layers' blocks and brings the
+    /// RTW tables into the pass's table buffer.
+    fn upload(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        uniforms: &DepthUniforms<'_>,
+    ) -> Result<(), BackendError> {
         if uniforms.technique() != self.desc.technique {
             return Err(BackendError::InvalidInput("uniforms of another technique"));
         }
@@ -444,11 +489,6 @@ impl ShadowDepthPass {
         if uniforms.layer_count() != layers {
             return Err(BackendError::InvalidInput(
                 "uniform layer count differs from the pass",
-            ));
-        }
-        if !(meshes.len() == 1 || meshes.len() == layers) {
-            return Err(BackendError::InvalidInput(
-                "need one mesh, or one per layer",
             ));
         }
         match uniforms {
@@ -487,7 +527,6 @@ impl ShadowDepthPass {
                 &uniforms.layer_bytes(layer, self.desc.resolution),
             );
         }
-        self.record(encoder, meshes);
         Ok(())
     }
 
@@ -512,32 +551,43 @@ impl ShadowDepthPass {
     /// Records the passes with the uniforms already written (the per-frame GPU work
     /// without any upload).
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder, meshes: &[&MeshBuffers]) {
-        let clear = if self.desc.reversed_z { 0.0 } else { 1.0 };
-        for (layer, view) in self.layer_views.iter().enumerate() {
+        for layer in 0..self.layer_views.len() {
             let Some(mesh) = meshes.get(layer).or_else(|| meshes.first()) else {
                 return;
             };
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shadowmap depth pass"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(clear),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &self.bind_group, &[(self.slot * layer as u64) as u32]);
+            let mut pass = self.begin_layer(encoder, layer);
             pass.set_vertex_buffer(0, mesh.vertices.slice(..));
             pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..mesh.index_count, 0, 0..1);
         }
+    }
+
+    /// Begins the render pass of `layer` (cleared) with the pipeline and the layer's
+    /// block bound.
+    fn begin_layer<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        layer: usize,
+    ) -> wgpu::RenderPass<'e> {
+        let clear = if self.desc.reversed_z { 0.0 } else { 1.0 };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shadowmap depth pass"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.layer_views[layer],
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[(self.slot * layer as u64) as u32]);
+        pass
     }
 
     /// Reads the whole depth texture back: layer-major, then row-major, row 0 at
@@ -551,7 +601,7 @@ impl ShadowDepthPass {
 }
 
 /// Texels of both RTW tables a block declares.
-fn rtw_table_texels(raw: &RtwShadowRaw) -> usize {
+pub(crate) fn rtw_table_texels(raw: &RtwShadowRaw) -> usize {
     (raw.sizes[0] as usize).saturating_add(raw.sizes[1] as usize)
 }
 

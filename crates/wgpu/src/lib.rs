@@ -19,6 +19,7 @@
 //! | [`profile`] | [`profile::GpuProfiler`]: GPU time per pass from timestamp queries |
 //! | [`reduce`] | depth min/max reduction (SDSM, IPSM depth bounds) |
 //! | [`rtw`] | [`rtw::GpuRtw`]: importance, blur, warp tables on the GPU |
+//! | [`refine`] | [`refine::GpuRefine`]: RTW caster subdivision as a compute pass writing an indirect draw |
 //! | [`volume`] | [`volume::VolumeRenderer`]: stencil shadow volumes (z-pass, z-fail with caps), the exact mask; [`volume::misclassification`] of any technique against it; [`volume::ProjectiveRenderer`]: projective shadows |
 //! | [`shaders`] | every WGSL source, embedded |
 //!
@@ -87,8 +88,10 @@
 //!   `(i + 0.5) / N`, `T[0] = T[N-1] = 0`, sampled by hand with the texel-centre
 //!   linear, clamp-to-edge semantics of `shadowmap_rtw::forward_warp`. Written by
 //!   the CPU ([`uniforms::RtwShadowRaw::tables`]) or by [`rtw::GpuRtw`] (fed to the
-//!   depth pass by [`rtw::GpuRtw::depth_uniforms`]). Casters are subdivided on the
-//!   CPU ([`depth::subdivide_for_rtw`]) since only vertices are warped.
+//!   depth pass by [`rtw::GpuRtw::depth_uniforms`]). Casters are subdivided since
+//!   only vertices are warped: on the GPU every frame ([`refine::GpuRefine`], drawn
+//!   by [`depth::ShadowDepthPass::encode_refined`]) or on the CPU, the reference
+//!   ([`depth::subdivide_for_rtw`]); both follow one split rule.
 //! - **Subpixel snap.** The paraboloid and RTW vertex shaders snap positions to the
 //!   1/256-pixel grid of the rasterizer: their maps compress, so casters become
 //!   slivers with depth slopes near 1 per texel, and rasterizers differ in whether
@@ -138,6 +141,10 @@
 //! subdivide_rtw/city_block_256_cells_2048          64 ms  (5264 -> 722 512 triangles)
 //! encode/cascades_4_depth_passes                   25 us
 //! encode/rtw_depth_pass_256_cell_tables            23 us
+//! rtw_frame_cpu/city_block_2048_tables_256_gpu_refine  51 us  (same run as a 66 ms
+//!     subdivide_rtw: tables built, casters refined and the depth pass drawn
+//!     indirectly on the GPU, 5264 -> 696 144 triangles there; 1/1300 of the CPU
+//!     subdivision it replaces)
 //! ```
 
 pub mod compose;
@@ -153,6 +160,7 @@ pub mod uniforms;
 
 // --- compute passes: depth reduction, RTW pipeline (another author) ---
 pub mod reduce;
+pub mod refine;
 pub mod rtw;
 
 // --- shadow volumes and projective shadows ---
@@ -204,6 +212,9 @@ pub mod shaders {
     pub const RTW_IMPORTANCE: &str = include_str!("../shaders/rtw_importance.wgsl");
     /// RTW per-axis blur, normalization, temporal smoothing, floor and warp table.
     pub const RTW_WARP: &str = include_str!("../shaders/rtw_warp.wgsl");
+    /// RTW caster refinement (count, choose, emit) writing an indirect draw; its
+    /// table sampler is a placeholder until composed ([`crate::compose::rtw_refine`]).
+    pub const RTW_REFINE: &str = include_str!("../shaders/rtw_refine.wgsl");
 
     // --- shadow volumes, projective shadows (volume_*, projective_*) ---
     /// Stencil shadow volumes: surfaces, two-sided stencil count, classification.

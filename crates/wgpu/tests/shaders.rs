@@ -79,14 +79,14 @@ fn validate(name: &str, source: &str) -> Result<(), String> {
 }
 
 /// Sources composed at runtime (WGSL has no includes): every scene shader (lookup +
-/// filter) of the renderer and RTW's depth pass (with the shared table sampler),
-/// each with its composition result.
+/// filter) of the renderer, RTW's depth pass and caster refinement (with the shared
+/// table sampler), each with its composition result.
 fn composed_sources() -> Vec<(&'static str, Result<String, shadowmap_wgpu::BackendError>)> {
     shadowmap_wgpu::render::composed_shaders()
 }
 
-/// Lookups times filters the renderer composes, and RTW's depth pass.
-const COMPOSITIONS: usize = 4 * 5 + 1;
+/// Lookups times filters the renderer composes, RTW's depth pass and refinement.
+const COMPOSITIONS: usize = 4 * 5 + 2;
 
 #[test]
 fn every_shader_file_parses_and_validates() {
@@ -132,7 +132,7 @@ fn composed_sources_parse_and_validate() {
     assert_eq!(
         composed.len(),
         COMPOSITIONS,
-        "every lookup with every filter, and RTW's depth pass"
+        "every lookup with every filter, RTW's depth pass and refinement"
     );
     let errors: Vec<String> = composed
         .iter()

@@ -83,7 +83,8 @@ pub struct RenderOptions {
     /// Paraboloid caster subdivision (its resolution is replaced by
     /// `shadow_resolution`).
     pub subdivision: SubdivisionOptions,
-    /// How casters are subdivided for RTW ([`crate::depth::subdivide_for_rtw`]; its resolution is
+    /// How casters are subdivided for RTW (on the GPU by [`crate::refine::GpuRefine`],
+    /// the twin of [`crate::depth::subdivide_for_rtw`]; its resolution is
     /// replaced by `shadow_resolution`). Default [`RtwSubdivision::default`]: pieces
     /// of at most 2 table cells whose straight warped image misses the warp by at
     /// most a quarter texel, at most 32 per original edge.

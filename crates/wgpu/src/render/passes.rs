@@ -11,8 +11,9 @@ use super::pipelines::{ScenePipeline, VsmPipelines, create_vsm_pipelines, moment
 use super::{RenderOptions, ShadowFilter, ShadowTechnique};
 use crate::depth::{
     DepthBias, DepthPassDesc, DepthTechnique, DepthUniforms, MeshBuffers, ShadowDepthPass,
-    subdivide_for_rtw, table_buffer,
+    table_buffer,
 };
+use crate::refine::{GpuRefine, RefineOptions};
 use crate::uniforms::{FrameRaw, RtwShadowRaw, ToRaw, paraboloid_layers};
 use crate::{BackendError, GpuContext};
 
@@ -86,27 +87,32 @@ impl DepthJob<'_> {
         Ok(DepthOutput { pass, tables: None })
     }
 
-    /// One layer from casters subdivided against the warp tables.
+    /// One layer from casters refined against the warp tables on the GPU
+    /// ([`GpuRefine`], the twin of the CPU reference `subdivide_for_rtw`), drawn
+    /// indirectly.
     fn rtw(
         &self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         shadow: &RtwShadow<'_>,
     ) -> Result<DepthOutput, BackendError> {
-        let mut out = Vec::new();
         let sub = self
             .options
             .rtw_subdivision
             .with_resolution(self.options.shadow_resolution);
-        subdivide_for_rtw(shadow, self.triangles, &sub, &mut out);
-        let mesh = MeshBuffers::from_triangles(ctx, &out)?;
+        let mut refine = GpuRefine::new(
+            ctx,
+            self.triangles,
+            &RefineOptions::default().with_subdivision(sub),
+        )?;
         let tables = RtwShadowRaw::tables(shadow);
         let mut pass = ShadowDepthPass::new(ctx, &self.desc(DepthTechnique::Rtw, 1))?;
         let uniforms = DepthUniforms::Rtw {
             raw: shadow.to_raw(),
             tables: &tables,
         };
-        pass.encode(ctx, encoder, &[&mesh], &uniforms)?;
+        refine.encode(ctx, encoder, &uniforms)?;
+        pass.encode_refined(ctx, encoder, &refine, &uniforms)?;
         Ok(DepthOutput {
             pass,
             tables: Some(tables),
