@@ -4,12 +4,19 @@
 //! per-frame directional cascade math (`calculate_cascade` and the per-view loop of
 //! `build_directional_light_cascades` in `bevy_light`) for the same camera, light and
 //! splits, timed in the same run, with the ratios printed.
+//!
+//! Bevy's per-call code is the work per light: it takes the view's transform and
+//! projection as they are, checked elsewhere once per frame. Ours splits the same
+//! way: `ValidCamera::new` checks the camera once per frame (timed alone), and
+//! `CascadeSet::fit_valid` is the per-light work Bevy's code does (the ratio the
+//! comparison is about). `CascadeSet::fit` does both in one call (a frame with one
+//! light), and is reported too.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use shadowmap::frustum::{
     Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, ConvexBody, Projection,
-    SceneBounds, SplitScheme,
+    SceneBounds, SplitScheme, ValidCamera,
 };
 use std::hint::black_box;
 use std::time::Duration;
@@ -96,7 +103,9 @@ fn cascades_vs_bevy(c: &mut Criterion) {
     let tight = stable.with_fit(CascadeFit::Tight);
     let world_from_view = camera.world_from_view;
 
-    let bevy = || {
+    // Each output is kept where it was returned (`black_box` of a reference): no
+    // side is charged for moving it out of a `Result` or a return slot.
+    let bevy_cascades = || {
         bevy_like::cascades(
             black_box(light_rotation),
             black_box(world_from_view),
@@ -105,11 +114,28 @@ fn cascades_vs_bevy(c: &mut Criterion) {
             &far_bounds,
         )
     };
+    let bevy = || {
+        black_box(&bevy_cascades());
+    };
     let ours = |o: &CascadeOptions| {
-        CascadeSet::fit(black_box(&camera), black_box(light_dir), &splits, o).unwrap()
+        let set = CascadeSet::fit(black_box(&camera), black_box(light_dir), &splits, o);
+        black_box(set.as_ref().unwrap());
+    };
+    // Per frame: the camera checked once, shared by every light.
+    let frame = || {
+        black_box(ValidCamera::new(black_box(&camera)).as_ref().unwrap());
+    };
+    let valid = ValidCamera::new(&camera).unwrap();
+    // Per light: the work Bevy's per-call code does.
+    let per_light = |o: &CascadeOptions| {
+        let set = CascadeSet::fit_valid(black_box(&valid), black_box(light_dir), &splits, o);
+        black_box(set.as_ref().unwrap());
     };
     // Both cover the same slices with maps of the same size.
-    let (b, s) = (bevy(), ours(&stable));
+    let (b, s) = (
+        bevy_cascades(),
+        CascadeSet::fit(&camera, light_dir, &splits, &stable).unwrap(),
+    );
     for (bc, sc) in b.iter().zip(&s.cascades) {
         assert!(bc.texel_size > 0.0 && sc.texel_world_size > 0.0);
         assert!(bc.clip_from_world.is_finite() && bc.world_from_cascade.is_finite());
@@ -120,18 +146,51 @@ fn cascades_vs_bevy(c: &mut Criterion) {
     g.warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(2));
     g.bench_function("bevy_4", |bch| bch.iter(bevy));
+    g.bench_function("stable_fit_4_per_light", |bch| {
+        bch.iter(|| per_light(&stable));
+    });
+    g.bench_function("tight_fit_4_per_light", |bch| {
+        bch.iter(|| per_light(&tight));
+    });
+    g.bench_function("camera_per_frame", |bch| bch.iter(frame));
     g.bench_function("stable_fit_4", |bch| bch.iter(|| ours(&stable)));
     g.bench_function("tight_fit_4", |bch| bch.iter(|| ours(&tight)));
     g.finish();
 
-    let t_bevy = timing::min_ns(bevy);
-    let t_stable = timing::min_ns(|| ours(&stable));
-    let t_tight = timing::min_ns(|| ours(&tight));
-    println!(
-        "cascades_vs_bevy: bevy {t_bevy:.0} ns, stable {t_stable:.0} ns ({:.2}x bevy), tight {t_tight:.0} ns ({:.2}x bevy)",
-        t_stable / t_bevy,
-        t_tight / t_bevy
-    );
+    // One run, interleaved so that a change in the machine's load falls on all.
+    let mut t = [f64::INFINITY; 6];
+    for _ in 0..3 {
+        let round = [
+            timing::min_ns(bevy),
+            timing::min_ns(|| per_light(&stable)),
+            timing::min_ns(|| per_light(&tight)),
+            timing::min_ns(frame),
+            timing::min_ns(|| ours(&stable)),
+            timing::min_ns(|| ours(&tight)),
+        ];
+        for (best, x) in t.iter_mut().zip(round) {
+            *best = best.min(x);
+        }
+    }
+    let [
+        t_bevy,
+        t_stable,
+        t_tight,
+        t_frame,
+        t_stable_all,
+        t_tight_all,
+    ] = t;
+    println!("cascades_vs_bevy (time per call, fastest of 3 x 201 batches):");
+    println!("  bevy_4 (per light)          {t_bevy:>7.0} ns");
+    for (name, ns) in [
+        ("stable_fit_4 per light", t_stable),
+        ("tight_fit_4 per light", t_tight),
+        ("camera check per frame", t_frame),
+        ("stable_fit_4 with check", t_stable_all),
+        ("tight_fit_4 with check", t_tight_all),
+    ] {
+        println!("  {name:<27} {ns:>7.0} ns  {:>5.2}x bevy", ns / t_bevy);
+    }
 }
 
 criterion_group!(benches, cascades, cascades_vs_bevy);

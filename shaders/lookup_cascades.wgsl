@@ -9,6 +9,9 @@ struct CascadeShadow {
     view_z_row: vec4<f32>,
     split_far: array<vec4<f32>, 2>,
     band_width: array<vec4<f32>, 2>,
+    // Scale of layer i's uv where its map fills only the layer's top-left corner
+    // (cube faces of different sizes): (x, y) of layer 2k, then of 2k + 1, in row k.
+    layer_uv_scale: array<vec4<f32>, 4>,
     count: u32,
     reversed_z: u32,
     select_by_projection: u32,
@@ -24,6 +27,11 @@ fn cascade_far(i: u32) -> f32 {
 
 fn cascade_band(i: u32) -> f32 {
     return shadow.band_width[i / 4u][i % 4u];
+}
+
+fn layer_uv_scale(i: u32) -> vec2<f32> {
+    let row = shadow.layer_uv_scale[i / 2u];
+    return select(row.xy, row.zw, i % 2u == 1u);
 }
 
 fn cascade_project(i: u32, world: vec3<f32>) -> vec4<f32> {
@@ -92,5 +100,6 @@ fn shadow_lookup(world: vec3<f32>, view_depth: f32, world_bias: f32, second: boo
     if second {
         index = min(index + 1u, min(shadow.count, 8u) - 1u);
     }
-    return cascade_project(index, world);
+    let s = cascade_project(index, world);
+    return vec4<f32>(s.xy * layer_uv_scale(index), s.zw);
 }

@@ -124,7 +124,12 @@ fn build_axis(
     var d_max = 0u;
     for (var i = lid; i < n; i += GROUP) {
         let current = select(scratch[offset + i] / peak, 1.0, fallback);
-        let mixed = alpha * density[offset + i] + (1.0 - alpha) * current;
+        // The history is read only when there is one: a fresh or reset buffer may
+        // hold anything (0 * NaN is NaN).
+        var mixed = current;
+        if alpha > 0.0 {
+            mixed = alpha * density[offset + i] + (1.0 - alpha) * current;
+        }
         let d = min(max(mixed, floor_density), 1.0);
         density[offset + i] = d;
         d_min = min(d_min, bitcast<u32>(d));

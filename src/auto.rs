@@ -1,12 +1,10 @@
 //! `auto`: the candidate technique with the lowest predicted aliasing error.
 
 use arrayvec::ArrayVec;
-use shadowmap_frustum::{
-    CascadeState, PredictOptions, PredictedError, ShadowMapping, TechniqueSelector, predict_errors,
-};
+use shadowmap_frustum::ShadowMapping;
 use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 
-use crate::fit::{FitError, FitInput, fit_stateful};
+use crate::fit::{FitError, FitInput, FitState, fit_candidate, predicted_percentiles};
 use crate::shadow::Shadow;
 use crate::technique::{CascadePlan, Technique};
 
@@ -15,7 +13,8 @@ pub const AUTO_CANDIDATE_COUNT: usize = 7;
 
 /// The candidates of [`Technique::Auto`] with this cascade plan, from the most to the
 /// least preferred when predictions tie: uniform, LiSPSM, TSM, XPSM (default
-/// options), tight, warped and stable cascades. A [`TechniqueSelector`] indexes this
+/// options), tight, warped and stable cascades. A
+/// [`TechniqueSelector`](shadowmap_frustum::TechniqueSelector) indexes this
 /// list.
 #[must_use]
 pub fn auto_candidates(plan: &CascadePlan) -> [Technique; AUTO_CANDIDATE_COUNT] {
@@ -40,16 +39,18 @@ pub fn auto_candidates(plan: &CascadePlan) -> [Technique; AUTO_CANDIDATE_COUNT] 
 pub(crate) fn fit_auto(
     plan: &CascadePlan,
     input: &FitInput<'_>,
-    selector: &mut TechniqueSelector,
-    cascades: &mut CascadeState,
+    state: &mut FitState,
 ) -> Result<Shadow, FitError> {
     let candidates = auto_candidates(plan);
     let mut fitted: [Option<Shadow>; AUTO_CANDIDATE_COUNT] = Default::default();
     for (slot, technique) in fitted.iter_mut().zip(&candidates) {
-        *slot = fit_stateful(technique, input, selector, cascades).ok();
+        *slot = fit_candidate(technique, input, state).ok();
     }
     let percentiles = predict(&fitted, input)?;
-    let chosen = selector.choose(&percentiles).ok_or(FitError::NoCandidate)?;
+    let chosen = state
+        .selector
+        .choose(&percentiles)
+        .ok_or(FitError::NoCandidate)?;
     let mut shadow = fitted
         .get_mut(chosen)
         .and_then(Option::take)
@@ -72,26 +73,11 @@ fn predict(
             mappings.push((s as &dyn ShadowMapping, s.layer_side));
         }
     }
-    let mut predicted = [None::<PredictedError>; AUTO_CANDIDATE_COUNT];
-    let predicted = predicted
-        .get_mut(..mappings.len())
-        .ok_or(FitError::NoCandidate)?;
-    // Surfaces the light does not face are dark whatever the map holds: the
-    // prediction ranks the candidates on the lit faces of the receivers' box.
-    let mut options = PredictOptions::default();
-    if let shadowmap_frustum::Light::Directional { direction } = *input.light {
-        options = options.with_light_direction(direction);
-    }
-    predict_errors(
-        input.camera,
-        &input.scene.receivers,
-        &mappings,
-        &options,
-        predicted,
-    )?;
+    let mut predicted = [None; AUTO_CANDIDATE_COUNT];
+    predicted_percentiles(input, &mappings, &mut predicted)?;
     let mut percentiles = [None; AUTO_CANDIDATE_COUNT];
-    for (i, p) in index.iter().zip(predicted.iter()) {
-        percentiles[*i] = p.map(|p| p.percentile);
+    for (i, p) in index.iter().zip(predicted) {
+        percentiles[*i] = p;
     }
     Ok(percentiles)
 }

@@ -3,21 +3,21 @@
 use alloc::vec::Vec;
 use core::fmt;
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use shadowmap_frustum::math::{floor, sqrt};
 use shadowmap_frustum::{
-    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, DepthBounds,
-    FrustumError, Light, MAX_CASCADES, SceneBounds, ShadowMapping, ShadowTransform, SplitScheme,
-    TechniqueSelector, ValidCamera, fit_spot,
+    Camera, CascadeState, DepthBounds, FRONT_LIT_MIN_COS, FrustumError, Light,
+    MAX_PREDICT_CANDIDATES, PredictOptions, PredictedError, SceneBounds, ShadowMapping,
+    ShadowTransform, TechniqueSelector, fit_spot, predict_errors,
 };
-use shadowmap_paraboloid::{CubeMap, IpsmOptions, IpsmPlan, ParaboloidError, ParaboloidMap, Side};
-use shadowmap_rtw::{BasePoint, EyeSample, ImportanceMap, OracleAxis, RtwError, WarpMaps};
-use shadowmap_warp::{
-    LispsmOptions, WarpError, lispsm, tsm, uniform_focused, warped_cascades, xpsm,
-};
+use shadowmap_paraboloid::{ParaboloidError, ParaboloidMap};
+use shadowmap_rtw::{EyeSample, ImportanceMap, OracleAxis, RtwError, WarpMaps};
+use shadowmap_warp::{WarpError, lispsm, spot_warp, tsm, uniform_focused, xpsm};
 
+use crate::cascaded::{fit_cascades, fit_warped};
+use crate::point_fit;
 use crate::shadow::{Fitted, Shadow};
-use crate::technique::{CascadePlan, DpsmOptions, RtwPlan, Technique};
+use crate::technique::{DpsmOptions, RtwPlan, Technique};
 
 /// What a technique may look at in one frame: the same for every technique.
 ///
@@ -203,19 +203,28 @@ pub fn fit_with_selector(
     input: &FitInput<'_>,
     selector: &mut TechniqueSelector,
 ) -> Result<Shadow, FitError> {
-    fit_stateful(technique, input, selector, &mut CascadeState::new())
+    let mut state = FitState {
+        selector: *selector,
+        ..FitState::default()
+    };
+    let shadow = fit_with_state(technique, input, &mut state);
+    *selector = state.selector;
+    shadow
 }
 
 /// What a renderer keeps from one frame to the next for one light and view:
-/// `auto`'s choice and the stable cascades' held sizes and count. Start with
-/// `FitState::default()` and pass the same value to [`fit_with_state`] every frame.
+/// `auto`'s choice, the stable cascades' held maps, and the cascade counts. Start
+/// with `FitState::default()` and pass the same value to [`fit_with_state`] every
+/// frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FitState {
     /// `auto`'s current choice, kept with hysteresis.
     pub selector: TechniqueSelector,
-    /// The stable cascades' sizes (and the cascaded techniques' count), kept with
-    /// hysteresis.
+    /// The stable cascades' maps (and the stable and tight cascades' count), kept
+    /// with hysteresis.
     pub cascades: CascadeState,
+    /// The warped cascades' count, kept with hysteresis (their maps are not held).
+    pub warped: CascadeState,
 }
 
 /// [`fit`], with the caller-held `state` threaded through the frames: `auto` keeps
@@ -231,16 +240,6 @@ pub fn fit_with_state(
     input: &FitInput<'_>,
     state: &mut FitState,
 ) -> Result<Shadow, FitError> {
-    fit_stateful(technique, input, &mut state.selector, &mut state.cascades)
-}
-
-/// [`fit_with_state`] with its two parts of the state apart.
-pub(crate) fn fit_stateful(
-    technique: &Technique,
-    input: &FitInput<'_>,
-    selector: &mut TechniqueSelector,
-    cascades: &mut CascadeState,
-) -> Result<Shadow, FitError> {
     if !technique.applies_to(input.light) {
         return Err(FitError::WrongLight {
             technique: technique.name(),
@@ -250,15 +249,27 @@ pub(crate) fn fit_stateful(
         return Err(FitError::InvalidBudget);
     }
     if let Technique::Auto(plan) = technique {
-        return crate::auto::fit_auto(plan, input, selector, cascades);
+        return crate::auto::fit_auto(plan, input, state);
     }
-    let (fitted, layers) = fit_one(technique, input, cascades)?;
+    fit_candidate(technique, input, state)
+}
+
+/// [`fit_with_state`] for every technique but `auto`, its inputs checked.
+pub(crate) fn fit_candidate(
+    technique: &Technique,
+    input: &FitInput<'_>,
+    state: &mut FitState,
+) -> Result<Shadow, FitError> {
+    let (fitted, layers) = fit_one(technique, input, state)?;
+    let layer_side = fitted
+        .own_layer_side()
+        .unwrap_or_else(|| input.layer_side(layers));
     Ok(Shadow {
         requested: *technique,
         technique: *technique,
         fitted,
         layers,
-        layer_side: input.layer_side(layers),
+        layer_side,
     })
 }
 
@@ -266,7 +277,7 @@ pub(crate) fn fit_stateful(
 fn fit_one(
     technique: &Technique,
     input: &FitInput<'_>,
-    state: &mut CascadeState,
+    state: &mut FitState,
 ) -> Result<(Fitted, u32), FitError> {
     let (camera, scene) = (input.camera, &input.scene);
     let direction = match *input.light {
@@ -283,10 +294,10 @@ fn fit_one(
         Technique::Tsm(o) => (Fitted::Tsm(tsm(camera, direction, scene, o)?), 1),
         Technique::StableCascades(plan) | Technique::TightCascades(plan) => {
             let stable = matches!(technique, Technique::StableCascades(_));
-            fit_cascades(plan, stable, direction, input, state)?
+            fit_cascades(plan, stable, direction, input, &mut state.cascades)?
         }
         Technique::WarpedCascades { plan, lispsm } => {
-            fit_warped(plan, lispsm, direction, input, state)?
+            fit_warped(plan, lispsm, direction, input, &mut state.warped)?
         }
         Technique::Rtw(plan) | Technique::RtwOracle(plan) => {
             let base = uniform_focused(camera, direction, scene, &Default::default())?;
@@ -298,14 +309,18 @@ fn fit_one(
             let s = fit_spot(input.light, &frustum, Some(scene), *reversed_z)?;
             (Fitted::Spot(s), 1)
         }
+        Technique::SpotWarp(o) => {
+            let s = spot_warp(input.light, camera, input.depth_bounds, scene, o)?;
+            (Fitted::SpotWarp(s), 1)
+        }
         Technique::Dpsm(o) => (Fitted::Dpsm(fit_dpsm(o, input.light)?), 2),
         Technique::Ipsm(o) => {
-            let plan = IpsmPlan::new(input.light, camera, input.depth_bounds, o)?;
+            let plan = point_fit::fit_ipsm(o, input)?;
             let layers = plan.map.layers();
             (Fitted::Ipsm(plan), layers)
         }
         Technique::CubeMaps(o) => {
-            let cube = CubeMap::fit(input.light, camera, input.depth_bounds, scene, o)?;
+            let cube = point_fit::fit_cube(o, input)?;
             let layers = cube.layers();
             (Fitted::Cube(cube), layers)
         }
@@ -317,153 +332,62 @@ fn fit_one(
             (fit_rtw(plan, false, technique.name(), base, input)?, 1)
         }
         Technique::PointRtw { ipsm, rtw } => {
-            let fitted = fit_point_rtw(ipsm, rtw, input)?;
+            let fitted = point_fit::fit_point_rtw(ipsm, rtw, input)?;
+            let layers = fitted.layer_count();
+            (fitted, layers)
+        }
+        Technique::CubeRtw { cube, rtw } => {
+            let fitted = point_fit::fit_cube_rtw(cube, rtw, input)?;
             let layers = fitted.layer_count();
             (fitted, layers)
         }
     })
 }
 
-fn fit_cascades(
-    plan: &CascadePlan,
-    stable: bool,
-    direction: Vec3,
-    input: &FitInput<'_>,
-    state: &mut CascadeState,
-) -> Result<(Fitted, u32), FitError> {
-    let splits = cascade_splits(plan, input, state)?;
-    let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
-    let fit = CascadeOptions::default()
-        .with_resolution(input.layer_side(layers))
-        .with_reversed_z(plan.reversed_z)
-        .with_scene(Some(input.scene))
-        .with_fit(if stable {
-            CascadeFit::Stable
-        } else {
-            CascadeFit::Tight
-        });
-    let camera = ValidCamera::new(input.camera)?;
-    let set = CascadeSet::fit_with_state(&camera, direction, &splits, &fit, state)?;
-    Ok((Fitted::Cascades(set), layers))
-}
-
-fn fit_warped(
-    plan: &CascadePlan,
-    options: &LispsmOptions,
-    direction: Vec3,
-    input: &FitInput<'_>,
-    state: &mut CascadeState,
-) -> Result<(Fitted, u32), FitError> {
-    // The same split rule as the unwarped cascades: count and range from the depth
-    // bounds, so no cascade is spent on empty depth.
-    let splits = cascade_splits(plan, input, state)?;
-    let count = splits.count();
-    let etas = [options.eta; MAX_CASCADES];
-    let cascades = warped_cascades(
-        input.camera,
-        direction,
-        &input.scene,
-        &splits,
-        etas.get(..count).unwrap_or(&[]),
-        options,
-    )?;
-    let fitted = Fitted::WarpedCascades {
-        cascades,
-        eye: input.camera.eye(),
-        forward: input.camera.forward(),
-    };
-    Ok((fitted, u32::try_from(count).unwrap_or(u32::MAX)))
-}
-
-/// A count kept from the previous frame stays while its score is within this factor
-/// of the best count's (see [`cascade_splits`]).
-const COUNT_KEEP_RATIO: f64 = 1.1;
-
-/// Splits of the cascaded techniques: practical splits of the depth bounds (the
-/// camera's range without them), so no cascade covers empty depth.
+/// The predicted 95th percentile of each of `mappings` (mapping, texels per side),
+/// all on the same rays (`shadowmap_frustum::predict_errors` with
+/// [`predict_options`]), into `out` (`None`: not predicted).
 ///
-/// The count is the one whose coarsest cascade is finest where it matters: the
-/// perspective aliasing of a cascade is largest at its near end, where a texel of
-/// world size `t` covers the most pixels, in proportion to `t / z_near`. For each
-/// count `k` up to `plan.max_cascades` (only those whose map side is a power of two
-/// when there are any: the stable fit's whole-texel motion is exact in `f32` only
-/// there), the slices are fitted tight to slice ∩ receivers on `side(k)` texels and
-/// scored by the largest `t / z_near` over the cascades that meet the receivers; the
-/// lowest score wins. Where the receivers bound the view (a room), the far slices'
-/// footprints stop growing with depth and fewer, larger maps win; over open ground
-/// the footprint grows with depth and more cascades win (Zhang et al.'s reasoning
-/// for parallel splits). The count of the previous frame (held in `state`) is kept
-/// while its score is within [`COUNT_KEEP_RATIO`] of the best, so a view near the
-/// boundary between two counts does not re-size every map from one frame to the
-/// next.
-fn cascade_splits(
-    plan: &CascadePlan,
+/// # Errors
+/// The prediction's errors; [`FitError::NoCandidate`] for more mappings than it
+/// compares at once.
+pub(crate) fn predicted_percentiles(
     input: &FitInput<'_>,
-    state: &mut CascadeState,
-) -> Result<CascadeSplits, FitError> {
-    let camera = input.camera;
-    let (near, far) = match input.depth_bounds {
-        Some(bounds) => bounds.clamped_to(camera)?,
-        None => camera.depth_range()?,
-    };
-    let max = plan.max_cascades.clamp(1, MAX_CASCADES);
-    let side = |k: usize| input.layer_side(u32::try_from(k).unwrap_or(u32::MAX));
-    let any_power = (1..=max).any(|k| side(k).is_power_of_two());
-    let allowed = |k: usize| (1..=max).contains(&k) && (!any_power || side(k).is_power_of_two());
-    let scheme = SplitScheme::Practical {
-        lambda: plan.split_lambda,
-    };
-    let splits_of = |k: usize| -> Result<CascadeSplits, FitError> {
-        Ok(CascadeSplits::new(&scheme, k, near, far)?.with_overlap(plan.overlap)?)
-    };
-    let valid = ValidCamera::new(camera)?;
-    let direction = match *input.light {
-        Light::Directional { direction } => direction,
-        _ => Vec3::ZERO,
-    };
-    let mut scores = [f64::INFINITY; MAX_CASCADES + 1];
-    for (k, score) in scores.iter_mut().enumerate() {
-        if allowed(k) {
-            let splits = splits_of(k)?;
-            *score = coarseness(&valid, direction, &splits, side(k), &input.scene);
+    mappings: &[(&dyn ShadowMapping, u32)],
+    out: &mut [Option<f64>],
+) -> Result<(), FitError> {
+    let mut predicted = [None::<PredictedError>; MAX_PREDICT_CANDIDATES];
+    let predicted = predicted
+        .get_mut(..mappings.len())
+        .ok_or(FitError::NoCandidate)?;
+    predict_errors(
+        input.camera,
+        &input.scene.receivers,
+        mappings,
+        &predict_options(input),
+        predicted,
+    )?;
+    for (slot, p) in out.iter_mut().zip(predicted.iter()) {
+        *slot = p.map(|p| p.percentile);
+    }
+    Ok(())
+}
+
+/// Options of the error prediction for a frame: surfaces the light does not face
+/// are dark whatever the map holds, so a directional light's prediction ranks on
+/// the lit faces of the receivers' box; and the visible surfaces lie within the
+/// depth bounds (when given), so no predicted point lies outside them.
+fn predict_options(input: &FitInput<'_>) -> PredictOptions {
+    let mut options = PredictOptions::default();
+    if let Light::Directional { direction } = *input.light {
+        options = options.with_light_direction(direction);
+    }
+    if let Some(bounds) = input.depth_bounds {
+        if let Ok((near, far)) = bounds.clamped_to(input.camera) {
+            options = options.with_depth_range(near, far);
         }
     }
-    let best = (1..=max)
-        .filter(|k| allowed(*k))
-        .min_by(|a, b| scores[*a].total_cmp(&scores[*b]).then(b.cmp(a)))
-        .unwrap_or(1);
-    let kept = state.count();
-    let keep = allowed(kept) && scores[kept] <= scores[best] * COUNT_KEEP_RATIO;
-    let count = if keep { kept } else { best };
-    state.set_count(count);
-    splits_of(count)
-}
-
-/// The score of a split in [`cascade_splits`]: the largest texel size over near
-/// depth, `t / z_near`, of its cascades fitted tight to slice ∩ receivers on
-/// `side`-texel maps, over the cascades that meet the receivers (infinite when the
-/// fit fails or none does).
-fn coarseness(
-    camera: &ValidCamera,
-    direction: Vec3,
-    splits: &CascadeSplits,
-    side: u32,
-    scene: &SceneBounds,
-) -> f64 {
-    let options = CascadeOptions::default()
-        .with_resolution(side)
-        .with_fit(CascadeFit::Tight)
-        .with_scene(Some(*scene));
-    let Ok(set) = CascadeSet::fit_valid(camera, direction, splits, &options) else {
-        return f64::INFINITY;
-    };
-    set.cascades
-        .iter()
-        .filter(|c| !c.receivers_missed)
-        .map(|c| f64::from(c.texel_world_size) / f64::from(c.view_depth.0))
-        .filter(|s| s.is_finite())
-        .max_by(f64::total_cmp)
-        .unwrap_or(f64::INFINITY)
+    options
 }
 
 /// RTW over `base` (the uniform fit of a directional light, the spot fit of a spot
@@ -505,57 +429,42 @@ fn fit_rtw(
         }
         warps.build_separable(&map, &map_v, &plan.warp)?;
     } else {
-        map.accumulate_backward(&base, samples, None, &plan.importance)?;
+        match *input.light {
+            Light::Directional { direction } => {
+                let lit = front_lit(samples, direction);
+                map.accumulate_backward(&base, &lit, None, &plan.importance)?;
+                crate::rtw_strength::build_measured(
+                    &base, &map, &lit, camera, direction, &plan.warp, &mut warps,
+                )?;
+                return Ok(Fitted::Rtw { base, warps });
+            }
+            _ => {
+                map.accumulate_backward(&base, samples, None, &plan.importance)?;
+            }
+        }
         warps.build(&map, &plan.warp)?;
     }
     Ok(Fitted::Rtw { base, warps })
 }
 
-/// RTW over the IPSM paraboloid: per side, importance from the eye samples that side
-/// stores, in its `uv`, scaled by the paraboloid's footprint there (world extent of a
-/// unit of `uv` across the ray: `distance / sqrt(uv² per steradian)`), then that
-/// side's tables.
-fn fit_point_rtw(
-    ipsm: &IpsmOptions,
-    plan: &RtwPlan,
-    input: &FitInput<'_>,
-) -> Result<Fitted, FitError> {
-    let samples = input.eye_samples.ok_or(FitError::MissingInput {
-        technique: "point_rtw",
-        input: "eye_samples",
-    })?;
-    let ipsm = IpsmPlan::new(input.light, input.camera, input.depth_bounds, ipsm)?;
-    let map = ipsm.map;
-    let n = plan.importance_side;
-    let side_warps = |side: Side| -> Result<WarpMaps, FitError> {
-        let project = |p: DVec3| {
-            let s = map.map_point(p).filter(|s| s.layer == side.layer())?;
-            let world = p.as_vec3();
-            let per_sr = f64::from(map.texels_per_steradian(world, 1)?);
-            let toward_light = map.position.as_dvec3() - p;
-            Some(BasePoint {
-                uv: s.uv,
-                footprint: toward_light.length() / sqrt(per_sr),
-                toward_light,
-            })
-        };
-        let mut importance = ImportanceMap::new(n, n)?;
-        importance.accumulate_backward_with(project, samples, None, &plan.importance)?;
-        let mut warps = WarpMaps::new(n, n)?;
-        warps.build(&importance, &plan.warp)?;
-        Ok(warps)
-    };
-    let front = side_warps(Side::Front)?;
-    let back = if map.layers() == 2 {
-        Some(side_warps(Side::Back)?)
-    } else {
-        None
-    };
-    Ok(Fitted::PointRtw {
-        plan: ipsm,
-        front,
-        back,
-    })
+/// The eye samples a directional light travelling along `direction` reaches from
+/// the side the eye sees: normal (facing the eye, as a G-buffer's) with `n . l` at
+/// least `shadowmap_frustum::FRONT_LIT_MIN_COS`, or unknown (zero). The others are
+/// dark whatever the map holds (the quality measure leaves them out too), and a
+/// surface turned away from the light close to the eye would otherwise claim the
+/// densest rows and columns of the warp (twice the uniform fit's error in a room
+/// seen along the light).
+fn front_lit(samples: &[EyeSample], direction: Vec3) -> Vec<EyeSample> {
+    let toward = -direction.normalize_or_zero();
+    samples
+        .iter()
+        .filter(|s| {
+            s.normal
+                .try_normalize()
+                .is_none_or(|n| f64::from(n.dot(toward)) >= FRONT_LIT_MIN_COS)
+        })
+        .copied()
+        .collect()
 }
 
 fn fit_dpsm(options: &DpsmOptions, light: &Light) -> Result<ParaboloidMap, FitError> {
@@ -589,45 +498,23 @@ pub fn depth_bounds_of(camera: &Camera, samples: &[EyeSample]) -> Option<DepthBo
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Fitted;
-    use proptest::prelude::*;
-    use shadowmap_testgen::point_rtw::{PointRtwCase, check_point_rtw, point_rtw_case};
-    use shadowmap_testgen::strategy;
 
-    /// Fits RTW over the paraboloid to a case and checks its coverage; the number of
-    /// samples checked (0 when the fit refuses the case, e.g. a spot light).
-    fn fit_and_check(case: &PointRtwCase) -> usize {
-        let input = FitInput::new(
-            &case.plan.camera,
-            &case.plan.light,
-            // IPSM reads the camera and depth bounds, not the scene.
-            SceneBounds::whole(shadowmap_frustum::Aabb::new(Vec3::splat(-1.0), Vec3::ONE)),
-            1 << 16,
-        )
-        .with_eye_samples(&case.samples)
-        .with_depth_bounds(case.plan.bounds);
-        let technique = Technique::PointRtw {
-            ipsm: case.plan.options,
-            rtw: RtwPlan::default().with_importance_side(32),
+    #[test]
+    fn rtw_keeps_only_the_samples_the_light_reaches() {
+        let sample = |normal: Vec3| EyeSample {
+            position: Vec3::ZERO,
+            normal,
+            eye_distance: 1.0,
         };
-        let Ok(shadow) = fit(&technique, &input) else {
-            return 0;
-        };
-        let Fitted::PointRtw { plan, .. } = shadow.fitted() else {
-            panic!("point_rtw fitted something else");
-        };
-        assert_eq!(shadow.layers(), plan.map.layers());
-        check_point_rtw(case, &plan.map, &shadow)
-    }
-
-    proptest! {
-        #![proptest_config(shadowmap_testgen::proptest_config())]
-
-        /// Every sample the IPSM paraboloid stores is stored by RTW over it, in the
-        /// same layer, with the same depth, inside the map.
-        #[test]
-        fn point_rtw_covers_what_the_paraboloid_covers(case in strategy(point_rtw_case)) {
-            fit_and_check(&case);
-        }
+        let down = Vec3::new(0.0, -1.0, 0.0);
+        let samples = [
+            sample(Vec3::Y),                   // lit head-on
+            sample(Vec3::new(1.0, 0.1, 0.0)),  // lit at about 6 degrees
+            sample(Vec3::new(1.0, 0.01, 0.0)), // within 3 degrees of edge-on
+            sample(Vec3::NEG_Y),               // turned away
+            sample(Vec3::ZERO),                // unknown: kept
+        ];
+        let kept = front_lit(&samples, down);
+        assert_eq!(kept, vec![samples[0], samples[1], samples[4]]);
     }
 }

@@ -62,8 +62,9 @@
 //! # Techniques
 //!
 //! The budget is split evenly over the layers: `k` layers of side
-//! `floor(sqrt(budget / k))`. Optional inputs: **S** eye samples, **D** depth bounds
-//! (the camera's range without them), **P** pixels per radian; bold = required.
+//! `floor(sqrt(budget / k))` (cube faces sized by need share it as tiles of one
+//! atlas instead). Optional inputs: **S** eye samples, **D** depth bounds (the
+//! camera's range without them), **P** pixels per radian; bold = required.
 //!
 //! | [`Technique`] | light | layers | reads | paper |
 //! |---|---|---|---|---|
@@ -77,23 +78,29 @@
 //! | `Rtw` | directional | 1 | **S** | Rosen, *Rectilinear texture warping for fast adaptive shadow mapping* |
 //! | `RtwOracle` | directional | 1 | **S**, **P** | RTW fed the exact required density (a limit, not a technique) |
 //! | `SpotFit` | spot | 1 | | perspective fit to frustum ∩ receivers |
+//! | `SpotWarp` | spot | 1 | D | LiSPSM (Wimmer et al.) or TSM (Martin and Tan) in the spot light's post-projective space, the strength kept where the error predicted on the receivers' box is within 10% of the best weaker warp's or the fit's |
 //! | `Dpsm` | point | 2 | | Brabec, Annen and Seidel, *Shadow mapping for hemispherical and omnidirectional light sources* |
-//! | `Ipsm` | point | 1 or 2 | D | Vanek, Navrátil, Herout and Zemčík, *High-quality shadows with improved paraboloid mapping*; `ConeFit::Exact` uses the exact minimal enclosing cone |
-//! | `CubeMaps` | point | 1..=6 | D | cube shadow maps, the engines' point-light baseline: the faces that see visible receivers, each focused on them (`CubeOptions::focused`) |
+//! | `Ipsm` | point | 1 or 2 | D, S and P | Vanek, Navrátil, Herout and Zemčík, *High-quality shadows with improved paraboloid mapping*; `ConeFit::Exact` uses the exact minimal enclosing cone; with S and P, the plan is measured on the samples against its dual alternatives (its own seam, a DPSM's axis) and the finest kept |
+//! | `CubeMaps` | point | 1..=6 | D, S and P | cube shadow maps, the engines' point-light baseline: the faces that see visible receivers, each focused on them (`CubeOptions::focused`); `FaceSizes::ByNeed` sizes the faces by the density they need (measured on S with P, else predicted on the receivers' box) |
 //! | `SpotRtw` | spot | 1 | **S** | Rosen's RTW over the spot fit (a perspective base) |
 //! | `PointRtw` | point | 1 or 2 | **S**, D | Rosen's RTW over each side of the IPSM paraboloid |
+//! | `CubeRtw` | point | 1..=6 | **S**, **P**, D | Rosen's RTW over each focused cube face, from the oracle's per-axis needs of the samples (true normals where lit from the front), each face narrowed to its samples and sized per axis by the error its warp leaves |
 //!
 //! Cascade count: for each count `k` up to [`CascadePlan::max_cascades`] (preferring
 //! power-of-two sides), practical splits of the depth bounds are fitted tight to
-//! slice ∩ receivers on `side(k)` texels, and the count whose coarsest cascade has
-//! the smallest texel size over near depth wins: open ground gets several cascades,
-//! a small room one map of the whole budget.
+//! slice ∩ receivers on `side(k)` texels, and the count of least predicted error
+//! (`shadowmap_frustum::predict_errors` within the depth bounds) wins, more than one
+//! cascade only where predicted at most 0.9 times the error of one: open ground gets
+//! several cascades, a small room one map of the whole budget. One cascade fits in
+//! the uniform fit's light frame, so it is never worse than the uniform fit; more
+//! fit in the frame lined up with the image.
 //!
 //! Across frames, [`fit_with_state`] threads a caller-held [`FitState`]: `auto`'s
-//! choice, the cascade count (kept unless another is clearly better) and each stable
-//! cascade's map size, fitted to slice ∩ receivers with
-//! [`STABLE_HEADROOM`](frustum::STABLE_HEADROOM) and kept while it still covers
-//! the footprint and is at most [`STABLE_SHRINK_RATIO`](frustum::STABLE_SHRINK_RATIO)
+//! choice, the cascade counts (kept unless another is clearly better) and each stable
+//! cascade's map extents and orientation, fitted to slice ∩ receivers turned by up
+//! to [`STABLE_TURN`](frustum::STABLE_TURN) with
+//! [`STABLE_HEADROOM`](frustum::STABLE_HEADROOM) and kept while they still cover
+//! the footprint and are at most [`STABLE_SHRINK_RATIO`](frustum::STABLE_SHRINK_RATIO)
 //! times too big, so the maps move by whole texels and shadow edges do not shimmer.
 //!
 //! `auto` fits every candidate and keeps the lowest predicted 95th-percentile error
@@ -106,7 +113,9 @@
 //!
 //! [`fit`] never panics: [`FitError`] says which input is wrong or missing, or wraps
 //! the math crate's own error. Every fit is allocation-free except RTW (its
-//! importance map and warp tables), the RTW oracle and RTW over the spot fit and the paraboloid.
+//! importance map and warp tables), the RTW oracle and RTW over the spot fit, the
+//! paraboloid and the cube's faces; measuring on eye samples uses at most 4096 of
+//! them, on the stack.
 #![cfg_attr(not(feature = "std"), no_std)]
 
 #[cfg(feature = "frustum")]
@@ -124,7 +133,15 @@ extern crate alloc;
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 mod auto;
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod cascaded;
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 mod fit;
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod point_fit;
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod rtw_strength;
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod sample_error;
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 mod shadow;
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]

@@ -1,10 +1,14 @@
 //! [`Shadow`]: a fitted technique, owning the math crates' own result types.
 
+use alloc::vec::Vec;
+
 use glam::{DVec3, Vec3};
 use shadowmap_frustum::{CascadeSet, ShadowMapping, ShadowSample, ShadowTransform, SpotShadow};
 use shadowmap_paraboloid::{CubeMap, IpsmPlan, ParaboloidMap};
 use shadowmap_rtw::{RtwShadow, WarpMaps};
-use shadowmap_warp::{LispsmShadow, TsmShadow, WarpedCascades, WarpedCascadesView, XpsmShadow};
+use shadowmap_warp::{
+    LispsmShadow, SpotWarpShadow, TsmShadow, WarpedCascades, WarpedCascadesView, XpsmShadow,
+};
 
 use crate::Technique;
 
@@ -49,12 +53,22 @@ pub enum Fitted {
     },
     /// The spot fit.
     Spot(SpotShadow),
+    /// LiSPSM or TSM in the spot light's post-projective space.
+    SpotWarp(SpotWarpShadow),
     /// The dual paraboloid map.
     Dpsm(ParaboloidMap),
     /// The IPSM plan (its map is single or dual).
     Ipsm(IpsmPlan),
     /// Cube shadow maps, one layer per kept face.
     Cube(CubeMap),
+    /// RTW over the focused faces of a cube map: the cube (its faces in an atlas)
+    /// and one pair of warp tables per kept face, in face order.
+    CubeRtw {
+        /// The cube map whose faces are warped.
+        cube: CubeMap,
+        /// Each face's tables.
+        warps: Vec<WarpMaps>,
+    },
     /// RTW over the IPSM paraboloid: the plan and one pair of warp tables per side.
     PointRtw {
         /// The paraboloid plan whose sides are warped.
@@ -109,16 +123,20 @@ impl Shadow {
         self.layers
     }
 
-    /// Side in texels of each (square) layer.
+    /// Side in texels of each (square) layer; for cube maps, the largest face's
+    /// (their faces may differ: see [`CubeMap::faces`]).
     #[must_use]
     pub const fn layer_side(&self) -> u32 {
         self.layer_side
     }
 
-    /// Texels over all layers (at most the budget).
+    /// Texels over all layers (at most the budget): for cube maps, their atlas.
     #[must_use]
-    pub const fn texels(&self) -> u64 {
-        self.layer_side as u64 * self.layer_side as u64 * self.layers as u64
+    pub fn texels(&self) -> u64 {
+        match self.cube() {
+            Some(cube) => cube.texels(),
+            _ => u64::from(self.layer_side) * u64::from(self.layer_side) * u64::from(self.layers),
+        }
     }
 
     /// The single matrix pair of a one-map matrix technique (uniform, LiSPSM, XPSM,
@@ -131,6 +149,7 @@ impl Shadow {
             Fitted::Xpsm(s) => Some(&s.transform),
             Fitted::Tsm(s) => Some(&s.transform),
             Fitted::Spot(s) => Some(&s.transform),
+            Fitted::SpotWarp(s) => Some(&s.transform),
             _ => None,
         }
     }
@@ -145,11 +164,12 @@ impl Shadow {
         }
     }
 
-    /// The cube map of [`Technique::CubeMaps`].
+    /// The cube map of [`Technique::CubeMaps`] and of RTW over its faces
+    /// ([`Technique::CubeRtw`]).
     #[must_use]
     pub const fn cube(&self) -> Option<&CubeMap> {
         match &self.fitted {
-            Fitted::Cube(cube) => Some(cube),
+            Fitted::Cube(cube) | Fitted::CubeRtw { cube, .. } => Some(cube),
             _ => None,
         }
     }
@@ -178,6 +198,17 @@ impl Shadow {
 }
 
 impl Fitted {
+    /// The layer side a result sets itself (cube maps: their largest face), `None`
+    /// where the layers share the budget equally.
+    pub(crate) fn own_layer_side(&self) -> Option<u32> {
+        match self {
+            Self::Cube(cube) | Self::CubeRtw { cube, .. } => {
+                Some(cube.largest_side()).filter(|side| *side > 0)
+            }
+            _ => None,
+        }
+    }
+
     /// Layers of this result: cascades, paraboloid sides, 1 for a single map.
     #[must_use]
     pub fn layer_count(&self) -> u32 {
@@ -186,7 +217,7 @@ impl Fitted {
             Self::WarpedCascades { cascades, .. } => cascades.cascades.len(),
             Self::Dpsm(map) => map.layers() as usize,
             Self::Ipsm(plan) | Self::PointRtw { plan, .. } => plan.map.layers() as usize,
-            Self::Cube(cube) => cube.faces.len(),
+            Self::Cube(cube) | Self::CubeRtw { cube, .. } => cube.faces.len(),
             _ => 1,
         };
         u32::try_from(count).unwrap_or(u32::MAX)
@@ -244,6 +275,10 @@ impl ShadowMapping for Shadow {
             Fitted::Dpsm(map) => map.map_point(world),
             Fitted::Ipsm(plan) => plan.map.map_point(world),
             Fitted::Cube(cube) => cube.map_point(world),
+            Fitted::CubeRtw { cube, warps } => {
+                let s = cube.map_point(world)?;
+                warps.get(s.layer as usize)?.warp_sample(s)
+            }
             Fitted::PointRtw { plan, front, back } => {
                 let s = plan.map.map_point(world)?;
                 let warps = if s.layer == 0 { front } else { back.as_ref()? };
@@ -253,7 +288,8 @@ impl ShadowMapping for Shadow {
             Fitted::Lispsm(LispsmShadow { transform, .. })
             | Fitted::Xpsm(XpsmShadow { transform, .. })
             | Fitted::Tsm(TsmShadow { transform, .. })
-            | Fitted::Spot(SpotShadow { transform, .. }) => transform.map_point(world),
+            | Fitted::Spot(SpotShadow { transform, .. })
+            | Fitted::SpotWarp(SpotWarpShadow { transform, .. }) => transform.map_point(world),
         }
     }
 }

@@ -4,7 +4,9 @@ use glam::Vec3;
 use shadowmap_frustum::Light;
 use shadowmap_paraboloid::{ConeFit, CubeOptions, IpsmOptions, MapOptions};
 use shadowmap_rtw::{ImportanceOptions, WarpOptions};
-use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
+use shadowmap_warp::{
+    LispsmOptions, SpotWarpKind, SpotWarpOptions, TsmOptions, UniformOptions, XpsmOptions,
+};
 
 /// A shadow technique with its options, chosen by value and fitted by
 /// [`fit`](crate::fit). Which light each one is for, and which optional
@@ -17,12 +19,19 @@ pub enum Technique {
     /// (`shadowmap_warp::uniform_focused`). Directional light.
     UniformFocused(UniformOptions),
     /// Parallel-split shadow maps (Zhang et al.), stable fit: each map fitted to
-    /// slice ∩ receivers with headroom, its size held across frames with hysteresis
-    /// ([`fit_with_state`](crate::fit_with_state)), texel snapping. Directional
-    /// light.
+    /// slice ∩ receivers with a small margin (a turn of the camera by
+    /// `STABLE_TURN` about `+Y`, 3% growth), its extents and orientation held across
+    /// frames with hysteresis ([`fit_with_state`](crate::fit_with_state)), texel
+    /// snapping: shadow edges do not shimmer, and the map costs the margin over the
+    /// tight fit, not the whole slice's bounding sphere (which cost 1.26x here).
+    /// Count and frame as [`Technique::TightCascades`]. Directional light.
     StableCascades(CascadePlan),
-    /// Parallel-split shadow maps, tight fit to slice ∩ receivers (SDSM-style).
-    /// Directional light.
+    /// Parallel-split shadow maps, tight fit to slice ∩ receivers over the depth
+    /// bounds (SDSM-style). The count is the one of least predicted error, more than
+    /// one only where predicted clearly better than one; one cascade fits in the
+    /// uniform fit's light frame, so it is the uniform fit narrowed to the depth
+    /// bounds and never worse than it; more fit in the frame lined up with the image
+    /// (see the crate docs). Directional light.
     TightCascades(CascadePlan),
     /// Light space perspective shadow maps (Wimmer, Scherzer and Purgathofer).
     /// Directional light.
@@ -31,7 +40,9 @@ pub enum Technique {
     Xpsm(XpsmOptions),
     /// Trapezoidal shadow maps (Martin and Tan). Directional light.
     Tsm(TsmOptions),
-    /// Parallel splits with a LiSPSM warp per cascade. Directional light.
+    /// Parallel splits with a LiSPSM warp per cascade, over the depth bounds; the
+    /// count is chosen from their own predicted error (one warped map over a short
+    /// range can beat four). Directional light.
     WarpedCascades {
         /// Split count and placement.
         plan: CascadePlan,
@@ -40,12 +51,22 @@ pub enum Technique {
     },
     /// The candidate of [`auto_candidates`](crate::auto_candidates) (uniform,
     /// LiSPSM, TSM, XPSM and the three cascaded techniques with this plan) with the
-    /// lowest error predicted from the camera, light and bounds alone, with
-    /// hysteresis across frames through a caller-held selector
-    /// ([`fit_with_selector`](crate::fit_with_selector)). Directional light.
+    /// lowest 95th-percentile error predicted from the camera, light and bounds alone
+    /// (`shadowmap_frustum::predict_errors`: the receivers' box within the depth
+    /// bounds, no rendering), with hysteresis across frames through a caller-held
+    /// selector ([`fit_with_selector`](crate::fit_with_selector)): candidates that
+    /// predict within the selector's margin of the current one do not take over, so
+    /// the choice does not flip every frame. The uniform fit is a candidate, so
+    /// `auto` is never predicted worse than it. Directional light.
     Auto(CascadePlan),
     /// Rectilinear texture warping (Rosen) over the uniform fit, importance from the
-    /// eye's samples (backward analysis). Directional light.
+    /// eye's samples (backward analysis) that the light reaches: a sample on a
+    /// surface turned away from the light is dark whatever the map holds and gets
+    /// no texels (near the eye it would otherwise claim the densest rows of the
+    /// warp). The warp's strength (the importance raised to `t` in `[0, 1]`, `t = 0`
+    /// the uniform fit) is the one of least 95th-percentile aliasing error measured
+    /// on those samples, so it is never worse than its base where the importance
+    /// model is off. Directional light.
     Rtw(RtwPlan),
     /// RTW fed the exact perspective-only density each axis requires: the limit RTW
     /// approaches. Directional light.
@@ -55,6 +76,10 @@ pub enum Technique {
         /// Reversed-Z depth.
         reversed_z: bool,
     },
+    /// LiSPSM or TSM in the spot light's post-projective space
+    /// (`shadowmap_warp::spot_warp`): the spot fit followed by a perspective warp of
+    /// its device plane along the view's centre line. Spot light.
+    SpotWarp(SpotWarpOptions),
     /// Dual paraboloid shadow map (Brabec et al.), not view-dependent. Point light.
     Dpsm(DpsmOptions),
     /// Improved paraboloid shadow maps (Vanek et al.): truncated frustum, cone fit,
@@ -76,6 +101,17 @@ pub enum Technique {
     PointRtw {
         /// The paraboloid plan (cone fit, cut, single or dual).
         ipsm: IpsmOptions,
+        /// The warp.
+        rtw: RtwPlan,
+    },
+    /// Rectilinear texture warping (Rosen) over each focused face of the cube map:
+    /// each kept face's `uv` is a base, importance from the eye samples it stores,
+    /// one pair of warp tables per face, and the faces share the budget (an atlas)
+    /// in proportion to the error their warps leave. Point light.
+    CubeRtw {
+        /// The cube's faces and focusing (its budget and face sizes are set by the
+        /// fit).
+        cube: CubeOptions,
         /// The warp.
         rtw: RtwPlan,
     },
@@ -253,9 +289,10 @@ impl LightKind {
 }
 
 impl Technique {
-    /// Every technique with default options, in report order.
+    /// Every technique with default options, in report order (RTW over the spot
+    /// fit, the paraboloid and the cube's faces aside).
     #[must_use]
-    pub fn all_default() -> [Self; 16] {
+    pub fn all_default() -> [Self; 18] {
         let plan = CascadePlan::default();
         let rtw = RtwPlan::default();
         [
@@ -273,6 +310,8 @@ impl Technique {
             Self::Rtw(rtw),
             Self::RtwOracle(rtw),
             Self::SpotFit { reversed_z: false },
+            Self::SpotWarp(SpotWarpOptions::default()),
+            Self::SpotWarp(SpotWarpOptions::default().with_kind(SpotWarpKind::Tsm)),
             Self::Dpsm(DpsmOptions::default()),
             Self::Ipsm(IpsmOptions::default().with_fit(ConeFit::Paper)),
             Self::Ipsm(IpsmOptions::default().with_fit(ConeFit::Exact)),
@@ -297,6 +336,10 @@ impl Technique {
             Self::Rtw(_) => "rtw",
             Self::RtwOracle(_) => "rtw_oracle",
             Self::SpotFit { .. } => "spot",
+            Self::SpotWarp(o) => match o.kind {
+                SpotWarpKind::Lispsm => "spot_lispsm",
+                SpotWarpKind::Tsm => "spot_tsm",
+            },
             Self::Dpsm(_) => "dpsm",
             Self::Ipsm(o) => match o.fit {
                 ConeFit::Paper => "ipsm_paper",
@@ -311,6 +354,7 @@ impl Technique {
             }
             Self::SpotRtw(_) => "spot_rtw",
             Self::PointRtw { .. } => "point_rtw",
+            Self::CubeRtw { .. } => "cube_rtw",
         }
     }
 
@@ -318,10 +362,12 @@ impl Technique {
     #[must_use]
     pub const fn light_kind(&self) -> LightKind {
         match self {
-            Self::SpotFit { .. } | Self::SpotRtw(_) => LightKind::Spot,
-            Self::Dpsm(_) | Self::Ipsm(_) | Self::CubeMaps(_) | Self::PointRtw { .. } => {
-                LightKind::Point
-            }
+            Self::SpotFit { .. } | Self::SpotWarp(_) | Self::SpotRtw(_) => LightKind::Spot,
+            Self::Dpsm(_)
+            | Self::Ipsm(_)
+            | Self::CubeMaps(_)
+            | Self::PointRtw { .. }
+            | Self::CubeRtw { .. } => LightKind::Point,
             _ => LightKind::Directional,
         }
     }

@@ -1,11 +1,14 @@
 //! `fit` allocates nothing per frame for every technique but RTW (its importance map
-//! and tables), `auto` included, under a counting global allocator (one test in this
-//! binary, so nothing else allocates meanwhile).
+//! and tables), `auto` included, and IPSM and cube maps measured on eye samples,
+//! under a counting global allocator (one test in this binary, so nothing else
+//! allocates meanwhile).
 
 use std::alloc::System;
 
 use glam::Vec3;
 use shadowmap::frustum::{Aabb, Camera, Light, Projection, SceneBounds, TechniqueSelector};
+use shadowmap::paraboloid::{CubeOptions, FaceSizes, IpsmOptions};
+use shadowmap::rtw::EyeSample;
 use shadowmap::{FitInput, Technique, fit_with_selector};
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
 
@@ -46,9 +49,43 @@ fn fit_does_not_allocate() {
     // Every technique but the two RTW ones.
     assert_eq!(techniques.len(), Technique::all_default().len() - 2);
     let mut selector = TechniqueSelector::new();
+    // With the eye's samples, IPSM and cube maps sized by need measure on them.
+    let samples: Vec<EyeSample> = (0..2000)
+        .map(|k| {
+            let p = Vec3::new(
+                -40.0 + (k % 50) as f32 * 1.6,
+                0.0,
+                -2.0 - (k / 50) as f32 * 3.0,
+            );
+            EyeSample {
+                position: p,
+                normal: Vec3::Y,
+                eye_distance: p.distance(camera.eye()),
+            }
+        })
+        .collect();
+    let measured = [
+        Technique::Ipsm(IpsmOptions::default()),
+        Technique::CubeMaps(CubeOptions::default().with_sizes(FaceSizes::ByNeed)),
+    ];
 
-    let region = Region::new(GLOBAL);
+    // Counted around each call only: the test harness's own threads may allocate
+    // between calls.
+    let mut allocations = (0, 0);
     let mut fitted = 0;
+    let mut counted = |technique: &Technique, input: &FitInput<'_>| {
+        let region = Region::new(GLOBAL);
+        let layers = fit_with_selector(technique, input, &mut selector)
+            .unwrap()
+            .layers();
+        let stats = region.change();
+        allocations.0 += stats.allocations;
+        allocations.1 += stats.reallocations;
+        if stats.allocations + stats.reallocations > 0 {
+            eprintln!("{}: {stats:?}", technique.name());
+        }
+        layers
+    };
     for frame in 0..5 {
         let camera = Camera {
             world_from_view: glam::Mat4::from_translation(Vec3::new(frame as f32 * 0.37, 0.0, 0.0))
@@ -61,15 +98,15 @@ fn fit_does_not_allocate() {
                 .find(|l| technique.applies_to(l))
                 .unwrap();
             let input = FitInput::new(&camera, light, scene, 2048 * 2048);
-            let shadow = fit_with_selector(technique, &input, &mut selector).unwrap();
-            fitted += shadow.layers();
+            fitted += counted(technique, &input);
         }
     }
-    let stats = region.change();
+    for technique in &measured {
+        let input = FitInput::new(&camera, &lamp, scene, 2048 * 2048)
+            .with_eye_samples(&samples)
+            .with_pixels_per_radian(500.0);
+        fitted += counted(technique, &input);
+    }
     assert!(fitted as usize >= 5 * techniques.len());
-    assert_eq!(
-        (stats.allocations, stats.reallocations),
-        (0, 0),
-        "{stats:?}"
-    );
+    assert_eq!(allocations, (0, 0), "allocations, reallocations");
 }

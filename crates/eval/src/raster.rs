@@ -59,6 +59,8 @@ pub const MAX_RASTER_SIDE: u32 = 32768;
 /// Largest number of texels (all layers) the rasterizer allocates.
 pub const MAX_RASTER_TEXELS: u64 = 1 << 30;
 
+mod layers;
+
 /// A projected vertex: WebGPU clip coordinates and a user clip distance.
 ///
 /// The parts of a triangle where the linearly interpolated `clip_distance` is negative
@@ -163,9 +165,9 @@ impl RasterOptions {
 /// A rendered depth map (array).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DepthMap {
-    /// Width in texels.
+    /// Width in texels (of the widest layer, see [`DepthMap::layer_size`]).
     pub width: u32,
-    /// Height in texels.
+    /// Height in texels (of the highest layer).
     pub height: u32,
     /// Number of layers.
     pub layers: u32,
@@ -173,6 +175,8 @@ pub struct DepthMap {
     pub reversed_z: bool,
     /// Depth, layer-major then row-major; row 0 is `v = 0` (top).
     pub depth: Vec<f32>,
+    /// Each layer's size, when they differ ([`DepthMap::from_layers`]).
+    sizes: Option<Vec<(u32, u32)>>,
 }
 
 impl DepthMap {
@@ -209,6 +213,7 @@ impl DepthMap {
             layers,
             reversed_z,
             depth: vec![clear; texels as usize],
+            sizes: None,
         })
     }
 
@@ -225,12 +230,13 @@ impl DepthMap {
     /// Stored depth of texel `(x, y)` in `layer`, `None` out of range.
     #[must_use]
     pub fn try_get(&self, layer: u32, x: u32, y: u32) -> Option<f32> {
-        (layer < self.layers && x < self.width && y < self.height)
-            .then(|| self.depth[self.index(layer, x, y)])
+        let (w, h) = self.layer_size(layer);
+        (layer < self.layers && x < w && y < h).then(|| self.depth[self.index(layer, x, y)])
     }
 
     fn index(&self, layer: u32, x: u32, y: u32) -> usize {
-        (layer as usize * self.height as usize + y as usize) * self.width as usize + x as usize
+        let (w, _) = self.layer_size(layer);
+        self.layer_offset(layer) + y as usize * w as usize + x as usize
     }
 
     /// The depth a cleared texel holds: 1, or 0 with reversed-Z.
@@ -245,14 +251,17 @@ impl DepthMap {
     #[must_use]
     pub fn texel_of(&self, sample: &ShadowSample) -> Option<(u32, u32)> {
         let uv = sample.uv;
+        let (w, h) = self.layer_size(sample.layer);
         if !(sample.layer < self.layers
+            && w > 0
+            && h > 0
             && (0.0..=1.0).contains(&uv.x)
             && (0.0..=1.0).contains(&uv.y))
         {
             return None;
         }
-        let x = ((uv.x * f64::from(self.width)) as u32).min(self.width - 1);
-        let y = ((uv.y * f64::from(self.height)) as u32).min(self.height - 1);
+        let x = ((uv.x * f64::from(w)) as u32).min(w - 1);
+        let y = ((uv.y * f64::from(h)) as u32).min(h - 1);
         Some((x, y))
     }
 
@@ -294,12 +303,13 @@ impl DepthMap {
     ) -> Option<bool> {
         let lit = self.is_lit(sample, bias)?;
         let (x, y) = self.texel_of(sample)?;
+        let (w, h) = self.layer_size(sample.layer);
         let r = radius;
-        for ny in y.saturating_sub(r)..=(y.saturating_add(r)).min(self.height - 1) {
-            for nx in x.saturating_sub(r)..=(x.saturating_add(r)).min(self.width - 1) {
+        for ny in y.saturating_sub(r)..=(y.saturating_add(r)).min(h - 1) {
+            for nx in x.saturating_sub(r)..=(x.saturating_add(r)).min(w - 1) {
                 let uv = glam::DVec2::new(
-                    (f64::from(nx) + 0.5) / f64::from(self.width),
-                    (f64::from(ny) + 0.5) / f64::from(self.height),
+                    (f64::from(nx) + 0.5) / f64::from(w),
+                    (f64::from(ny) + 0.5) / f64::from(h),
                 );
                 if self.is_lit(&ShadowSample { uv, ..*sample }, bias) != Some(lit) {
                     return None;
@@ -697,19 +707,7 @@ impl DepthProjector for ParaboloidProjector {
             _ => return None,
         };
         let s = self.map.project(world.as_vec3(), side)?;
-        let q = self
-            .map
-            .light_from_world
-            .as_dmat4()
-            .transform_vector3(world - self.map.position.as_dvec3());
-        let len = q.length();
-        if !(len > 0.0) {
-            return None;
-        }
-        let cos = match side {
-            Side::Front => -q.z / len,
-            Side::Back => q.z / len,
-        };
+        let cos = self.map.clip_distance(world.as_vec3(), side);
         let clip = DVec4::new(2.0 * s.uv.x - 1.0, 1.0 - 2.0 * s.uv.y, s.depth, 1.0);
         Some(ClipVertex::new(clip, cos))
     }

@@ -11,22 +11,27 @@
 //! | light | techniques |
 //! |---|---|
 //! | directional | uniform focused, stable and tight cascades (PSSM over the depth bounds), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), auto (the candidate with the lowest predicted error), RTW (backward importance), RTW oracle |
-//! | spot | spot fit, RTW over the spot fit |
-//! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone, cube maps focused on the visible receivers, cube maps of full faces, RTW over the IPSM paraboloid |
+//! | spot | spot fit, LiSPSM and TSM in the spot's post-projective space, RTW over the spot fit |
+//! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone (both measured on the eye's samples against their dual alternatives), cube maps focused on the visible receivers with faces sized by the samples' needs, the engines' cube maps (equal full faces: a reference, not one of the library's techniques), RTW over the IPSM paraboloid, RTW over the focused cube faces |
 //!
 //! Budget: `texel_budget` texels in total ([`TechniqueOptions`], default `1024²`),
 //! split evenly over the layers: one `1024²` map, four cascades of `512²`, a dual
 //! paraboloid of `2 x 724²` (an IPSM plan that falls back to dual gets `2 x 724²`
-//! too; cube maps share it over their kept faces, `k x floor(sqrt(1024² / k))²`). A technique that cannot handle a frame returns
+//! too); the engines' cube maps share it over their kept faces,
+//! `k x floor(sqrt(1024² / k))²`, the focused cube maps and RTW over them as tiles of
+//! one atlas whose area (gaps included) is within the budget and is the `texels`
+//! counted (the metrics count the faces' own texels). A technique that cannot handle a frame returns
 //! [`EvalError::Technique`] with the math crate's reason, never panics.
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use shadowmap::paraboloid::{
-    ConeFit, CubeOptions, IpsmOptions, Side, SubdivisionOptions, subdivide_triangles,
+    ConeFit, CubeMap, CubeOptions, FaceSizes, IpsmOptions, Side, SubdivisionOptions,
+    subdivide_triangles,
 };
 use shadowmap::rtw::{
-    EyeSample, RtwSubdivision, WarpMaps, subdivide_for_rtw, subdivide_for_rtw_with,
+    EyeSample, RtwSubdivision, WarpMaps, subdivide_for_rtw, subdivide_for_rtw_clipped,
 };
+use shadowmap::warp::{SpotWarpKind, SpotWarpOptions};
 use shadowmap::{
     CascadePlan, FitInput, FitState, Fitted, RtwPlan, Shadow, depth_bounds_of, fit_with_state,
 };
@@ -55,12 +60,14 @@ pub enum TechniqueKind {
     /// Orthographic fit of frustum ∩ receivers (`shadowmap_warp::uniform_focused`).
     UniformFocused,
     /// PSSM, stable: `CascadeSet::fit_with_state`, each map fitted to slice ∩
-    /// receivers with headroom and its size held along the camera path with
-    /// hysteresis; practical splits of the eye's depth bounds, the count from the
-    /// fitted footprints (see `shadowmap::fit_with_state`).
+    /// receivers with a margin for a small turn and growth, its extents and
+    /// orientation held along the camera path with hysteresis; practical splits of
+    /// the eye's depth bounds, the count from the predicted error (see
+    /// `shadowmap::fit_with_state`).
     StableCascades,
     /// PSSM, tight (SDSM-style): `CascadeSet::fit` with the tight fit to slice ∩
-    /// receivers over the same splits as [`TechniqueKind::StableCascades`].
+    /// receivers over the same splits as [`TechniqueKind::StableCascades`]; one
+    /// cascade is the uniform fit narrowed to the depth bounds.
     TightCascades,
     /// Light space perspective shadow maps, `eta = 0`.
     Lispsm,
@@ -68,10 +75,11 @@ pub enum TechniqueKind {
     Xpsm,
     /// Trapezoidal shadow maps.
     Tsm,
-    /// PSSM with LiSPSM per cascade (`shadowmap_warp::warped_cascades`).
+    /// PSSM with LiSPSM per cascade (`shadowmap_warp::warped_cascades`), the count
+    /// from its own predicted error.
     WarpedCascades,
     /// Rectilinear texture warping over the uniform fit, importance from the eye's
-    /// samples (backward analysis).
+    /// samples the light reaches (backward analysis).
     Rtw,
     /// Picks, per frame, the matrix technique or cascades with the lowest error
     /// predicted from the camera, light and bounds alone
@@ -82,6 +90,11 @@ pub enum TechniqueKind {
     RtwOracle,
     /// Perspective fit of a spot light (`shadowmap_frustum::fit_spot`).
     SpotFit,
+    /// LiSPSM in the spot light's post-projective space
+    /// (`shadowmap_warp::spot_warp`).
+    SpotLispsm,
+    /// TSM in the spot light's post-projective space.
+    SpotTsm,
     /// Dual paraboloid (front facing world `-Y`), not view-dependent.
     Dpsm,
     /// IPSM with the paper's averaged cone.
@@ -89,9 +102,12 @@ pub enum TechniqueKind {
     /// IPSM with the exact minimal cone.
     IpsmExact,
     /// Cube maps: the faces that see visible receivers, each focused on them
-    /// (`shadowmap_paraboloid::CubeMap`); the point lights' baseline.
+    /// (`shadowmap_paraboloid::CubeMap`), sized by the density the eye's samples
+    /// need; the point lights' baseline.
     Cube,
-    /// Cube maps with the same faces at their full 90 degrees over the light's range.
+    /// The engines' cube maps: the same faces at their full 90 degrees over the
+    /// light's range, equal sides (one texture-array layer each). A reference row,
+    /// not one of the library's techniques.
     CubeUnfocused,
     /// Rectilinear texture warping over the spot fit (a perspective base), importance
     /// from the eye's samples.
@@ -99,11 +115,15 @@ pub enum TechniqueKind {
     /// Rectilinear texture warping over each side of the IPSM paraboloid (exact
     /// cone), importance from the eye's samples.
     PointRtw,
+    /// Rectilinear texture warping over each focused face of the cube map,
+    /// importance from the eye's samples, the faces sized by the error their warps
+    /// leave.
+    CubeRtw,
 }
 
 impl TechniqueKind {
     /// All techniques, in report order.
-    pub const ALL: [Self; 18] = [
+    pub const ALL: [Self; 21] = [
         Self::UniformFocused,
         Self::StableCascades,
         Self::TightCascades,
@@ -115,6 +135,8 @@ impl TechniqueKind {
         Self::Rtw,
         Self::RtwOracle,
         Self::SpotFit,
+        Self::SpotLispsm,
+        Self::SpotTsm,
         Self::Dpsm,
         Self::IpsmPaper,
         Self::IpsmExact,
@@ -122,7 +144,37 @@ impl TechniqueKind {
         Self::CubeUnfocused,
         Self::SpotRtw,
         Self::PointRtw,
+        Self::CubeRtw,
     ];
+
+    /// The technique this one must not lose to, of its own family: the uniform fit
+    /// for the directional techniques, the spot fit for the spot warps and RTW over
+    /// it, DPSM for the paraboloid maps (IPSM, RTW over its paraboloid), the focused
+    /// cube maps for RTW over their faces, the engines' cube maps (unfocused, equal
+    /// faces) for the focused ones. `None` for the baselines themselves and the RTW
+    /// oracle (a bound, not a technique).
+    #[must_use]
+    pub const fn baseline(self) -> Option<Self> {
+        match self {
+            Self::StableCascades
+            | Self::TightCascades
+            | Self::Lispsm
+            | Self::Xpsm
+            | Self::Tsm
+            | Self::WarpedCascades
+            | Self::Auto
+            | Self::Rtw => Some(Self::UniformFocused),
+            Self::SpotLispsm | Self::SpotTsm | Self::SpotRtw => Some(Self::SpotFit),
+            Self::IpsmPaper | Self::IpsmExact | Self::PointRtw => Some(Self::Dpsm),
+            Self::Cube => Some(Self::CubeUnfocused),
+            Self::CubeRtw => Some(Self::Cube),
+            Self::UniformFocused
+            | Self::RtwOracle
+            | Self::SpotFit
+            | Self::Dpsm
+            | Self::CubeUnfocused => None,
+        }
+    }
 
     /// Short identifier for tables and file names.
     #[must_use]
@@ -139,6 +191,8 @@ impl TechniqueKind {
             Self::Rtw => "rtw",
             Self::RtwOracle => "rtw_oracle",
             Self::SpotFit => "spot",
+            Self::SpotLispsm => "spot_lispsm",
+            Self::SpotTsm => "spot_tsm",
             Self::Dpsm => "dpsm",
             Self::IpsmPaper => "ipsm_paper",
             Self::IpsmExact => "ipsm_exact",
@@ -146,6 +200,7 @@ impl TechniqueKind {
             Self::CubeUnfocused => "cube_unfocused",
             Self::SpotRtw => "spot_rtw",
             Self::PointRtw => "point_rtw",
+            Self::CubeRtw => "cube_rtw",
         }
     }
 
@@ -182,11 +237,21 @@ impl TechniqueKind {
             Self::Rtw => T::Rtw(rtw),
             Self::RtwOracle => T::RtwOracle(rtw),
             Self::SpotFit => T::SpotFit { reversed_z: false },
+            Self::SpotLispsm => T::SpotWarp(SpotWarpOptions::default()),
+            Self::SpotTsm => T::SpotWarp(SpotWarpOptions::default().with_kind(SpotWarpKind::Tsm)),
             Self::Dpsm => T::Dpsm(Default::default()),
             Self::IpsmPaper => ipsm(ConeFit::Paper),
             Self::IpsmExact => ipsm(ConeFit::Exact),
-            Self::Cube => T::CubeMaps(CubeOptions::default()),
-            Self::CubeUnfocused => T::CubeMaps(CubeOptions::default().with_focused(false)),
+            Self::Cube => T::CubeMaps(CubeOptions::default().with_sizes(FaceSizes::ByNeed)),
+            Self::CubeUnfocused => T::CubeMaps(
+                CubeOptions::default()
+                    .with_focused(false)
+                    .with_sizes(FaceSizes::Equal),
+            ),
+            Self::CubeRtw => T::CubeRtw {
+                cube: CubeOptions::default(),
+                rtw,
+            },
             Self::SpotRtw => T::SpotRtw(rtw),
             Self::PointRtw => T::PointRtw {
                 ipsm: IpsmOptions::default().with_fit(ConeFit::Exact),
@@ -386,16 +451,19 @@ impl Technique {
         self.shadow.layers()
     }
 
-    /// Resolution `(width, height)` of each layer.
+    /// Resolution `(width, height)` of each layer (a cube map's faces may differ).
     #[must_use]
     pub fn layer_sizes(&self) -> Vec<(u32, u32)> {
+        if let Some(cube) = self.shadow.cube() {
+            return cube.faces.iter().map(|f| (f.size[0], f.size[1])).collect();
+        }
         let side = self.shadow.layer_side();
         vec![(side, side); self.layers() as usize]
     }
 
-    /// Texels over all layers.
+    /// Texels over all layers (a cube map's whole atlas).
     #[must_use]
-    pub const fn texels(&self) -> u64 {
+    pub fn texels(&self) -> u64 {
         self.shadow.texels()
     }
 
@@ -433,18 +501,8 @@ impl Technique {
         }
         match self.shadow.fitted() {
             Fitted::Cascades(set) => rasterize_depth(mesh, &MatrixProjector::from(set), &options),
-            Fitted::Cube(cube) => {
-                let matrices = cube
-                    .faces
-                    .iter()
-                    .map(|f| f.clip_from_world.as_dmat4())
-                    .collect();
-                rasterize_depth(
-                    mesh,
-                    &MatrixProjector::new(matrices, cube.reversed_z),
-                    &options,
-                )
-            }
+            Fitted::Cube(cube) => rasterize_cube(cube, None, mesh, &options),
+            Fitted::CubeRtw { cube, warps } => rasterize_cube(cube, Some(warps), mesh, &options),
             Fitted::WarpedCascades { cascades, .. } => {
                 let matrices = cascades
                     .cascades
@@ -491,9 +549,16 @@ impl Technique {
                 // image of the curved side, so it follows the paraboloid's curvature
                 // and the warp together (subdividing the paraboloid's pieces again
                 // would multiply the two limits: up to 16² x 32² pieces a caster).
+                // Casters are cut at the side's plane (the part behind is clipped),
+                // and an edge may be cut finely enough to cross the side's whole
+                // disc in pieces of the span bound.
                 let uv = |p: Vec3| map.project(p, which).map(|s| s.uv);
-                let rtw = RtwSubdivision::default().with_resolution(side);
-                subdivide_for_rtw_with(uv, warps, &triangles, &rtw, &mut pieces);
+                let clip = |p: Vec3| map.plane_distance(p, which);
+                let cells = warps.x_table().len().max(warps.y_table().len());
+                let rtw = RtwSubdivision::default()
+                    .with_resolution(side)
+                    .with_segments_for_extent(1.0 / f64::from(map.zoom), cells);
+                subdivide_for_rtw_clipped(uv, &[&clip], warps, &triangles, &rtw, &mut pieces);
                 let inner = WarpedProjector { inner: one, warps };
                 rasterize_depth(&mesh_of(&pieces), &inner, options)?
             } else {
@@ -506,6 +571,43 @@ impl Technique {
         }
         Ok(out)
     }
+}
+
+/// The faces of a cube map, each rendered by the matrix depth pass at its own side,
+/// one layer each (they are the tiles of the cube's atlas; the metrics count their
+/// texels, the report the atlas's). With warp tables (RTW over the faces), each
+/// face's casters are cut to its window's frustum, subdivided by the RTW rule and
+/// their vertices warped.
+fn rasterize_cube(
+    cube: &CubeMap,
+    warps: Option<&[WarpMaps]>,
+    mesh: &Mesh,
+    options: &RasterOptions,
+) -> Result<DepthMap, EvalError> {
+    let triangles: Vec<[Vec3; 3]> = mesh.triangles().map(|t| t.map(DVec3::as_vec3)).collect();
+    let mut pieces = Vec::new();
+    let mut faces = Vec::with_capacity(cube.faces.len());
+    for (i, f) in cube.faces.iter().enumerate() {
+        let clip = f.clip_from_world.as_dmat4();
+        let face_options = options.with_size(f.size[0], f.size[1]);
+        faces.push(match warps.and_then(|w| w.get(i)) {
+            Some(w) => {
+                let side = f.size[0].max(f.size[1]);
+                warped::face_pieces(clip, f.near, w, side, &triangles, &mut pieces);
+                let inner = warped::DividedProjector {
+                    clip_from_world: clip,
+                    reversed_z: cube.reversed_z,
+                };
+                let projector = WarpedProjector { inner, warps: w };
+                rasterize_depth(&mesh_of(&pieces), &projector, &face_options)?
+            }
+            None => {
+                let projector = MatrixProjector::new(vec![clip], cube.reversed_z);
+                rasterize_depth(mesh, &projector, &face_options)?
+            }
+        });
+    }
+    DepthMap::from_layers(faces)
 }
 
 /// A mesh of `f32` triangles.

@@ -56,6 +56,25 @@ pub(crate) fn bounding_sphere(corners: &[DVec3; 8]) -> (DVec3, f64) {
     (center, math::sqrt(farthest(center)))
 }
 
+/// [`bounding_sphere`] of the slice between view depths `near < far` of a symmetric
+/// pinhole camera: every ray from the eye, corner `(±t_x d, ±t_y d, -d)` at depth `d`,
+/// `k = t_x^2 + t_y^2`. Returns the centre's view depth (the centre lies on the view
+/// axis) and the radius, from the closed form of [`bounding_sphere`] without the
+/// corners:
+///
+/// ```text
+/// c = min(f, (n + f)(1 + k) / 2)      r^2 = max(k n^2 + (c - n)^2, k f^2 + (f - c)^2)
+/// ```
+///
+/// (the two distances are equal unless `c` is clamped to `f`).
+pub(crate) fn symmetric_slice_sphere(k: f64, near: f64, far: f64) -> (f64, f64) {
+    // Finite depths of a checked camera: no NaN for `min_num` and `max_num`.
+    let c = math::min_num(0.5 * (near + far) * (1.0 + k), far);
+    let (dn, df) = (c - near, far - c);
+    let r2 = math::max_num(k * near * near + dn * dn, k * far * far + df * df);
+    (c, math::sqrt(r2))
+}
+
 /// The closed-form parameter of [`bounding_sphere`] when the segment is perpendicular
 /// to both faces and each face's corners are equidistant from its centroid (to a
 /// relative `1e-12`); `None` otherwise.
@@ -150,7 +169,7 @@ pub(crate) fn bounding_sphere_search(corners: &[DVec3; 8]) -> (DVec3, f64) {
 
 #[cfg(test)]
 pub(crate) mod tests {
-    use super::{bounding_sphere, bounding_sphere_search};
+    use super::{bounding_sphere, bounding_sphere_search, symmetric_slice_sphere};
     use glam::DVec3;
     use proptest::prelude::*;
     use shadowmap_testgen::{arbitrary::Unstructured, camera, in_range, strategy};
@@ -215,6 +234,13 @@ pub(crate) mod tests {
     /// View-space corners of a random slice of a random valid camera (any projection,
     /// near-degenerate ones included).
     fn slice_corners(u: &mut Unstructured<'_>) -> shadowmap_testgen::GenResult<[DVec3; 8]> {
+        slice(u).map(|(g, n, f)| g.view_corners(n, f))
+    }
+
+    /// A random valid camera's geometry and a slice `(near, far)` of its depth range.
+    fn slice(
+        u: &mut Unstructured<'_>,
+    ) -> shadowmap_testgen::GenResult<(crate::camera::CameraGeometry, f64, f64)> {
         let camera = local(&camera(u)?);
         let g = camera
             .geometry()
@@ -227,7 +253,7 @@ pub(crate) mod tests {
         if !(f > n) {
             return Err(shadowmap_testgen::arbitrary::Error::IncorrectFormat);
         }
-        Ok(g.view_corners(n, f))
+        Ok((g, n, f))
     }
 
     proptest! {
@@ -245,6 +271,23 @@ pub(crate) mod tests {
             prop_assert!((c - c_ref).length() <= 1e-3 * scale + 1e-6 * scale, "{c} vs {c_ref}");
             for p in &corners {
                 prop_assert!(p.distance(c) <= r * (1.0 + 1e-12));
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(shadowmap_testgen::proptest_config())]
+
+        /// The symmetric pinhole closed form (no corners) gives the sphere of
+        /// `bounding_sphere` on the slice's corners, to rounding.
+        #[test]
+        fn symmetric_slice_sphere_matches_corners((g, n, f) in strategy(slice)) {
+            if let Some(k) = g.symmetric_k {
+                let (depth, r) = symmetric_slice_sphere(k, n, f);
+                let (c, r_ref) = bounding_sphere(&g.view_corners(n, f));
+                prop_assert!((r - r_ref).abs() <= 1e-12 * r_ref, "{r} vs {r_ref}");
+                prop_assert!((-c.z - depth).abs() <= 1e-12 * r_ref, "{depth} vs {c}");
+                prop_assert!(c.x == 0.0 && c.y == 0.0, "{c}");
             }
         }
     }

@@ -2,6 +2,8 @@ use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 
 use crate::frustum::{dplanes, f32_min_distance};
 use crate::geometry::DPlane;
+use crate::math::{max_num, min_num};
+use crate::rays::{Rays, symmetric_k};
 use crate::{Frustum, FrustumError, math, projection};
 
 /// Smallest accepted relative thickness `(far - near) / far` of a depth range: below
@@ -390,6 +392,17 @@ pub(crate) struct CameraGeometry {
     /// top-right, top-left.
     pub(crate) ray_origin: [DVec3; 4],
     pub(crate) ray_dir: [DVec3; 4],
+    /// The same rays in world space.
+    pub(crate) world_rays: Rays,
+    /// [`CameraGeometry::view_from_world`] in `f32`, as every cascade set stores it.
+    pub(crate) view_from_world32: Mat4,
+    /// How far outside `near..far` a slice may reach (`1e-6` relative).
+    slice_tolerance: f64,
+    /// `t_x^2 + t_y^2` when every ray starts at the eye and the rays are mirror
+    /// images about the view axis (`(±t_x, ±t_y, -1)`: a symmetric pinhole camera),
+    /// so a slice's bounding sphere has a closed form
+    /// ([`symmetric_slice_sphere`](crate::bounding_sphere::symmetric_slice_sphere)).
+    pub(crate) symmetric_k: Option<f64>,
     /// World corners of the whole depth range (`world_corners(near, far)`).
     corners: [DVec3; 8],
     /// Their inward planes (`dplanes(&corners, 0.0)`), as validation found them.
@@ -412,7 +425,8 @@ fn check_range(near: f64, far: f64, allow_non_positive_near: bool) -> Result<(),
     if (!allow_non_positive_near && near <= 0.0) || far <= near {
         return Err(err);
     }
-    let scale = far.abs().max(near.abs());
+    // Finite here (checked by every caller): no NaN for `max_num`.
+    let scale = max_num(far.abs(), near.abs());
     if (far - near) < MIN_RELATIVE_DEPTH_RANGE * scale {
         return Err(err);
     }
@@ -532,6 +546,10 @@ impl CameraGeometry {
             far,
             ray_origin,
             ray_dir,
+            world_rays: Rays::new(&world_from_view, &ray_origin, &ray_dir),
+            view_from_world32: Mat4::IDENTITY,
+            slice_tolerance: 1e-6 * far.abs().max(near.abs()).max(1e-30),
+            symmetric_k: symmetric_k(&ray_origin, &ray_dir),
             corners: [DVec3::ZERO; 8],
             planes: [DPlane {
                 normal: DVec3::Z,
@@ -555,6 +573,7 @@ impl CameraGeometry {
         // corners are finite, checked above).
         geometry.planes = dplanes(&corners, 0.0)?;
         geometry.corners = corners;
+        geometry.view_from_world32 = geometry.view_from_world().as_mat4();
         Ok(geometry)
     }
 
@@ -653,12 +672,12 @@ impl CameraGeometry {
     /// Clamps and checks a requested slice against the camera's range.
     pub(crate) fn check_slice(&self, near: f32, far: f32) -> Result<(f64, f64), FrustumError> {
         let (n, f) = (finite(near)?, finite(far)?);
-        let tol = 1e-6 * self.far.abs().max(self.near.abs()).max(1e-30);
+        let tol = self.slice_tolerance;
         let err = FrustumError::InvalidDepthRange { near, far };
         if n < self.near - tol || f > self.far + tol {
             return Err(err);
         }
-        let (n, f) = (n.max(self.near), f.min(self.far));
+        let (n, f) = (max_num(n, self.near), min_num(f, self.far));
         check_range(n, f, true)?;
         Ok((n, f))
     }

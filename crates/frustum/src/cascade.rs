@@ -2,51 +2,17 @@ use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
 
 use crate::body::ConvexBody;
-use crate::bounding_sphere::bounding_sphere;
+use crate::bounding_sphere::{bounding_sphere, symmetric_slice_sphere};
 use crate::camera::CameraGeometry;
-use crate::cascade_state::{CascadeState, held_box};
+use crate::cascade_state::{CascadeState, HeldSlot, held_box};
 use crate::light::unit;
 use crate::mapping::{LightDirection, ShadowSample, ShadowTransform, project_dmat};
+use crate::rays::Rays;
 use crate::split::CascadeBlend;
 use crate::{
-    Aabb, Camera, CascadeSplits, FrustumError, MAX_CASCADES, ShadowMapping, ValidCamera, math,
+    Aabb, Camera, CascadeSplits, FrustumError, MAX_CASCADES, MAX_RESOLUTION, SceneBounds,
+    ShadowMapping, ValidCamera, math,
 };
-
-/// Largest accepted shadow-map resolution (texels per side).
-pub const MAX_RESOLUTION: u32 = 65536;
-
-/// What casts and what receives shadows, as world-space boxes: the scene input of
-/// every scene-dependent fit in the library (cascades, spot fit, the warps' focus
-/// body, IPSM).
-///
-/// `receivers` bounds every surface that must look up the map; `casters` bounds every
-/// surface that is drawn into it. Often both are the scene bounds
-/// ([`SceneBounds::whole`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct SceneBounds {
-    /// Everything that receives shadows.
-    pub receivers: Aabb,
-    /// Everything that casts shadows.
-    pub casters: Aabb,
-}
-
-impl SceneBounds {
-    /// Receivers and casters given separately.
-    #[must_use]
-    pub const fn new(receivers: Aabb, casters: Aabb) -> Self {
-        Self { receivers, casters }
-    }
-
-    /// One box that both casts and receives.
-    #[must_use]
-    pub const fn whole(scene: Aabb) -> Self {
-        Self {
-            receivers: scene,
-            casters: scene,
-        }
-    }
-}
 
 /// How a cascade's light-space rectangle is chosen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -56,12 +22,16 @@ pub enum CascadeFit {
     /// the slice, but the map's size and texel grid change as the camera moves or
     /// turns, so shadow edges shimmer.
     Tight,
-    /// The box of the slice's bounding sphere, snapped to whole texels against a fixed
-    /// world anchor: the size is invariant under camera rotation and camera motion
-    /// moves the map by whole texels, so shadow edges do not shimmer. With a
-    /// power-of-two resolution the `f32` matrices keep the motion exact (the snapped
-    /// offset `k / resolution` is representable); other resolutions drift by about
-    /// `f32::EPSILON * k` texels after `k` texels of travel.
+    /// Shimmer-free. Without a caller-held state: the box of the slice's bounding
+    /// sphere, snapped to whole texels against a fixed world anchor: the size is
+    /// invariant under camera rotation and camera motion moves the map by whole
+    /// texels. With one ([`CascadeSet::fit_with_state`], scene bounds): the box of
+    /// slice ∩ receivers with a small margin for turning and growth, its extents and
+    /// orientation held across frames with hysteresis ([`CascadeState`]), snapped
+    /// likewise, so it pays a few percent over the tight fit instead of the sphere.
+    /// With a power-of-two resolution the `f32` matrices keep the motion exact (the
+    /// snapped offset `k / resolution` is representable); other resolutions drift by
+    /// about `f32::EPSILON * k` texels after `k` texels of travel.
     #[default]
     Stable,
 }
@@ -79,6 +49,8 @@ pub struct CascadeOptions {
     /// Reversed-Z depth (1 at the light's near plane).
     pub reversed_z: bool,
     /// Orients the light frame (see [`directional_light_from_world`](crate::directional_light_from_world)).
+    /// The stable fit with a caller-held state takes it only when it (re)sizes a
+    /// map, and then holds that orientation.
     pub up_hint: Vec3,
     /// Scene bounds for scene-dependent fitting.
     pub scene: Option<SceneBounds>,
@@ -168,6 +140,24 @@ pub struct Cascade {
     pub receivers_missed: bool,
 }
 
+impl Cascade {
+    /// A cascade's place before it is fitted (zeros: cheap to write).
+    const PLACEHOLDER: Self = Self {
+        view_depth: (0.0, 0.0),
+        transform: ShadowTransform {
+            light_from_world: Mat4::ZERO,
+            clip_from_world: Mat4::ZERO,
+            uv_from_world: Mat4::ZERO,
+            reversed_z: false,
+            light: LightDirection::Directional(Vec3::ZERO),
+        },
+        texel_world_size: 0.0,
+        light_depth: (0.0, 0.0),
+        caster_depth: None,
+        receivers_missed: false,
+    };
+}
+
 /// A fitted set of cascades for a directional light.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -210,6 +200,7 @@ impl CascadeSet {
     ///
     /// # Errors
     /// As [`CascadeSet::fit`], except the camera's.
+    #[inline]
     pub fn fit_valid(
         camera: &ValidCamera,
         light_direction: Vec3,
@@ -241,36 +232,63 @@ impl CascadeSet {
         Ok(set)
     }
 
+    /// The set, its cascades fitted by [`CascadeSet::fill`]; inline, so that a caller
+    /// receives the large set where it keeps it rather than through copies.
+    #[inline(always)]
     fn fit_inner(
         camera: &ValidCamera,
         light_direction: Vec3,
         splits: &CascadeSplits,
         options: &CascadeOptions,
-        mut state: Option<&mut CascadeState>,
+        state: Option<&mut CascadeState>,
     ) -> Result<Self, FrustumError> {
-        let fitter = Fitter::new(&camera.geometry, light_direction, options)?;
-        let mut set = Self {
+        // The result is made first and filled in place: the set is large.
+        let mut out = Ok(Self {
             cascades: ArrayVec::new(),
             splits: splits.clone(),
-            view_from_world: camera.geometry.view_from_world().as_mat4(),
+            view_from_world: camera.geometry.view_from_world32,
             resolution: options.resolution,
-        };
+        });
+        if let Ok(set) = &mut out
+            && let Err(e) = set.fill(camera, light_direction, options, state)
+        {
+            out = Err(e);
+        }
+        out
+    }
+
+    /// Fits one cascade per split of `self.splits` into `self.cascades`.
+    fn fill(
+        &mut self,
+        camera: &ValidCamera,
+        light_direction: Vec3,
+        options: &CascadeOptions,
+        mut state: Option<&mut CascadeState>,
+    ) -> Result<(), FrustumError> {
+        let checked = Fitter::check(light_direction, options)?;
+        let fitter = Fitter::new(&camera.geometry, checked, options);
+        let (splits, set) = (&self.splits, &mut self.cascades);
         for i in 0..splits.count() {
             let (near, far) = splits
                 .cascade_range(i)
                 .ok_or(FrustumError::InvalidCascadeCount)?;
             let held = state.as_deref_mut().and_then(|s| s.slot(i));
-            let cascade = match fitter.fit(near, far, held) {
+            // Fitted where it is kept: a cascade is large, and moving it out of a
+            // `Result` and into the set would copy it twice.
+            set.try_push(Cascade::PLACEHOLDER)
+                .map_err(|_| FrustumError::InvalidCascadeCount)?;
+            let Some(cascade) = set.last_mut() else {
+                return Err(FrustumError::InvalidCascadeCount);
+            };
+            match fitter.fit_into(near, far, held, cascade) {
                 Err(FrustumError::SliceOutsideScene) => {
-                    let mut c = fitter.fit_without_receivers(near, far)?;
-                    c.receivers_missed = true;
-                    c
+                    fitter.fit_without_receivers(near, far, cascade)?;
+                    cascade.receivers_missed = true;
                 }
                 other => other?,
-            };
-            set.cascades.push(cascade);
+            }
         }
-        Ok(set)
+        Ok(())
     }
 
     /// The cascade for a world point by its view depth, with the blend weight toward
@@ -320,7 +338,7 @@ pub fn fit_cascade(
     options: &CascadeOptions,
 ) -> Result<Cascade, FrustumError> {
     let geometry = camera.geometry()?;
-    let fitter = Fitter::new(&geometry, light_direction, options)?;
+    let fitter = Fitter::new(&geometry, Fitter::check(light_direction, options)?, options);
     let (n, f) = fitter.camera.check_slice(near_depth, far_depth)?;
     fitter.fit(n as f32, f as f32, None)
 }
@@ -336,21 +354,18 @@ struct Fitter<'a> {
     /// `light_from_world * world_from_view`: slice corners go to light space in one step.
     light_from_view: DMat4,
     /// The camera's edge rays in light space (see [`CameraGeometry`]).
-    light_ray_origin: [DVec3; 4],
-    light_ray_dir: [DVec3; 4],
-    /// The camera's edge rays in world space.
-    world_ray_origin: [DVec3; 4],
-    world_ray_dir: [DVec3; 4],
+    light_rays: Rays,
     options: CascadeOptions,
     scene: Option<SceneBounds>,
 }
 
 impl<'a> Fitter<'a> {
-    fn new(
-        camera: &'a CameraGeometry,
+    /// Checks the light and the options: the unit light direction and the checked
+    /// scene bounds.
+    fn check(
         light_direction: Vec3,
         options: &CascadeOptions,
-    ) -> Result<Self, FrustumError> {
+    ) -> Result<(DVec3, Option<SceneBounds>), FrustumError> {
         let light_dir = unit(light_direction)?;
         if !(4..=MAX_RESOLUTION).contains(&options.resolution) {
             return Err(FrustumError::InvalidResolution);
@@ -367,31 +382,38 @@ impl<'a> Fitter<'a> {
             }),
             None => None,
         };
+        Ok((light_dir, scene))
+    }
+
+    /// The fitter of checked input ([`Fitter::check`]); infallible, so it is built
+    /// where it is used rather than moved out of a `Result`.
+    fn new(
+        camera: &'a CameraGeometry,
+        (light_dir, scene): (DVec3, Option<SceneBounds>),
+        options: &CascadeOptions,
+    ) -> Self {
         let light_from_world = crate::projection::light_rotation(light_dir, options.up_hint);
         let light_from_view = light_from_world * camera.world_from_view;
-        Ok(Self {
+        Self {
             camera,
             light_dir,
             light_from_world,
             light_from_world32: light_from_world.as_mat4(),
             light_from_view,
-            light_ray_origin: core::array::from_fn(|i| {
-                light_from_view.transform_point3(camera.ray_origin[i])
-            }),
-            light_ray_dir: core::array::from_fn(|i| {
-                light_from_view.transform_vector3(camera.ray_dir[i])
-            }),
-            world_ray_origin: core::array::from_fn(|i| {
-                camera
-                    .world_from_view
-                    .transform_point3(camera.ray_origin[i])
-            }),
-            world_ray_dir: core::array::from_fn(|i| {
-                camera.world_from_view.transform_vector3(camera.ray_dir[i])
-            }),
+            // The stable fit reads only the light depth of the slice's corners.
+            light_rays: Rays::axes(
+                &light_from_view,
+                &camera.ray_origin,
+                &camera.ray_dir,
+                if options.fit == CascadeFit::Stable {
+                    2..3
+                } else {
+                    0..3
+                },
+            ),
             options: *options,
             scene,
-        })
+        }
     }
 
     /// The stable size ladder's step, when it applies (stable fit with scene bounds).
@@ -402,57 +424,89 @@ impl<'a> Fitter<'a> {
         }
     }
 
-    fn fit_without_receivers(&self, near: f32, far: f32) -> Result<Cascade, FrustumError> {
+    fn fit_without_receivers(
+        &self,
+        near: f32,
+        far: f32,
+        out: &mut Cascade,
+    ) -> Result<(), FrustumError> {
         let receiverless = Self {
             scene: None,
             ..*self
         };
-        receiverless.fit(near, far, None)
+        receiverless.fit_into(near, far, None, out)
     }
 
-    /// Fits the slice `[near, far]`; `held` is the caller-held size of the stable
+    /// The bounding sphere of the slice between view depths `n < f`
+    /// ([`bounding_sphere`]), its centre in light space: in closed form for a
+    /// symmetric pinhole camera, whose centre lies on the view axis.
+    fn slice_sphere(&self, n: f64, f: f64) -> (DVec3, f64) {
+        match self.camera.symmetric_k {
+            Some(k) => {
+                let (depth, radius) = symmetric_slice_sphere(k, n, f);
+                // View-space (0, 0, -depth) in light space.
+                let m = &self.light_from_view;
+                (m.w_axis.truncate() - m.z_axis.truncate() * depth, radius)
+            }
+            None => {
+                let (center, radius) = bounding_sphere(&self.camera.view_corners(n, f));
+                (self.light_from_view.transform_point3(center), radius)
+            }
+        }
+    }
+
+    /// Fits the slice `[near, far]`; `held` is the caller-held map of the stable
     /// fit (see [`CascadeState`]), used only with the stable fit and scene bounds.
-    fn fit(&self, near: f32, far: f32, held: Option<&mut DVec2>) -> Result<Cascade, FrustumError> {
+    fn fit(
+        &self,
+        near: f32,
+        far: f32,
+        held: Option<HeldSlot<'_>>,
+    ) -> Result<Cascade, FrustumError> {
+        let mut cascade = Cascade::PLACEHOLDER;
+        self.fit_into(near, far, held, &mut cascade)?;
+        Ok(cascade)
+    }
+
+    /// [`Fitter::fit`] into `out` (unchanged on error).
+    fn fit_into(
+        &self,
+        near: f32,
+        far: f32,
+        held: Option<HeldSlot<'_>>,
+        out: &mut Cascade,
+    ) -> Result<(), FrustumError> {
         let (n, f) = self.camera.check_slice(near, far)?;
+        if let (Some(scene), CascadeFit::Stable, Some(mut held)) =
+            (&self.scene, self.options.fit, held)
+        {
+            return self.fit_held(n, f, scene, &mut held, out);
+        }
         let light = &self.light_from_world;
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        // Largest world coordinate of the fitted points, for the invertibility test.
-        let mut reach = 0.0f64;
+        // Largest world coordinate of the fitted points, for the invertibility test
+        // (of the slice's corners, computed only if that test needs it).
+        let mut reach = None;
         match &self.scene {
             Some(scene) => {
-                // A slice too thin to clip reliably is treated like one that misses
-                // the receivers: the caller falls back to the whole slice.
-                let corners = self.camera.world_corners(n, f);
-                let body = ConvexBody::from_dcorners_aabb(&corners, &scene.receivers).map_err(
-                    |e| match e {
-                        FrustumError::DegenerateFrustum => FrustumError::SliceOutsideScene,
-                        e => e,
-                    },
-                )?;
-                if body.is_empty() {
-                    return Err(FrustumError::SliceOutsideScene);
-                }
+                let body = self.receivers_body(n, f, scene)?;
+                let mut max_abs = 0.0f64;
                 for v in body.vertices() {
                     let p = v.as_dvec3();
-                    reach = reach.max(p.abs().max_element());
+                    max_abs = max_abs.max(p.abs().max_element());
                     let q = light.transform_point3(p);
                     lo = lo.min(q);
                     hi = hi.max(q);
                 }
+                reach = Some(max_abs);
             }
-            None => {
-                for i in 0..4 {
-                    let (o, d) = (self.light_ray_origin[i], self.light_ray_dir[i]);
-                    let (wo, wd) = (self.world_ray_origin[i], self.world_ray_dir[i]);
-                    for depth in [n, f] {
-                        let q = o + d * depth;
-                        lo = lo.min(q);
-                        hi = hi.max(q);
-                        reach = reach.max((wo + wd * depth).abs().max_element());
-                    }
-                }
+            // The stable fit sizes the box by the slice's sphere: only the depth range
+            // is needed.
+            None if self.options.fit == CascadeFit::Stable => {
+                (lo.z, hi.z) = self.light_rays.range(2, n, f);
             }
+            None => (lo, hi) = self.light_rays.bounds(n, f),
         }
         let res = f64::from(self.options.resolution);
         let (xy_lo, xy_hi, texel) = match self.options.fit {
@@ -464,30 +518,120 @@ impl<'a> Fitter<'a> {
                 let (a, b) = (lo.truncate() - pad, hi.truncate() + pad);
                 (a, b, (b - a).max_element() / res)
             }
-            CascadeFit::Stable if self.scene.is_some() && held.is_some() => {
-                let mut none = DVec2::ZERO;
-                held_box(lo.truncate(), hi.truncate(), res, held.unwrap_or(&mut none))?
-            }
             CascadeFit::Stable if self.ladder_step().is_some() => {
                 let step = self.ladder_step().unwrap_or(2.0);
                 ladder_box(lo.truncate(), hi.truncate(), step, res)?
             }
             CascadeFit::Stable => {
-                let (center_view, radius) = bounding_sphere(&self.camera.view_corners(n, f));
-                let center = self.light_from_view.transform_point3(center_view);
+                let (center, radius) = self.slice_sphere(n, f);
                 // One texel of slack on each side absorbs the snap (at most half a texel).
                 let texel = 2.0 * radius / (res - 2.0);
                 if !(texel > 0.0 && texel.is_finite()) {
                     return Err(FrustumError::EmptyBounds);
                 }
-                let snapped = (center.truncate() / texel).round() * texel;
+                let snapped =
+                    DVec2::new(math::round(center.x / texel), math::round(center.y / texel))
+                        * texel;
                 let half = DVec2::splat(0.5 * res * texel);
                 (snapped - half, snapped + half, texel)
             }
         };
+        let frame = Frame {
+            light_from_world: *light,
+            light_from_world32: self.light_from_world32,
+        };
+        let fitted = FittedBox {
+            xy_lo,
+            xy_hi,
+            texel,
+            depth: (-hi.z, -lo.z),
+            reach,
+        };
+        self.finish(n, f, &frame, &fitted, out)
+    }
+
+    /// The vertices of slice `[n, f]` ∩ receivers. A slice too thin to clip
+    /// reliably is treated like one that misses the receivers
+    /// ([`FrustumError::SliceOutsideScene`]): the caller falls back to the whole
+    /// slice.
+    fn receivers_body(
+        &self,
+        n: f64,
+        f: f64,
+        scene: &SceneBounds,
+    ) -> Result<ConvexBody, FrustumError> {
+        let corners = self.camera.world_corners(n, f);
+        let body =
+            ConvexBody::from_dcorners_aabb(&corners, &scene.receivers).map_err(|e| match e {
+                FrustumError::DegenerateFrustum => FrustumError::SliceOutsideScene,
+                e => e,
+            })?;
+        if body.is_empty() {
+            return Err(FrustumError::SliceOutsideScene);
+        }
+        Ok(body)
+    }
+
+    /// The stable fit with a caller-held map ([`held_box`]): a square over
+    /// slice ∩ receivers whose side and orientation are kept across frames.
+    fn fit_held(
+        &self,
+        n: f64,
+        f: f64,
+        scene: &SceneBounds,
+        held: &mut HeldSlot<'_>,
+        out: &mut Cascade,
+    ) -> Result<(), FrustumError> {
+        let body = self.receivers_body(n, f, scene)?;
+        let points = body.vertices().iter().map(|v| v.as_dvec3());
+        let b = held_box(
+            &points,
+            self.light_dir,
+            &self.light_from_world,
+            f64::from(self.options.resolution),
+            held,
+        )?;
+        let (mut z_lo, mut z_hi, mut reach) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+        for p in points {
+            reach = reach.max(p.abs().max_element());
+            let z = b.light_from_world.transform_point3(p).z;
+            z_lo = z_lo.min(z);
+            z_hi = z_hi.max(z);
+        }
+        let frame = Frame {
+            light_from_world: b.light_from_world,
+            light_from_world32: b.light_from_world.as_mat4(),
+        };
+        let fitted = FittedBox {
+            xy_lo: b.lo,
+            xy_hi: b.hi,
+            texel: b.texel,
+            depth: (-z_hi, -z_lo),
+            reach: Some(reach),
+        };
+        self.finish(n, f, &frame, &fitted, out)
+    }
+
+    /// The cascade of slice `[n, f]` for the light-space rectangle of `fitted` in
+    /// `frame`: depth range pulled back to the casters over it, matrices, checks.
+    fn finish(
+        &self,
+        n: f64,
+        f: f64,
+        frame: &Frame,
+        fitted: &FittedBox,
+        out: &mut Cascade,
+    ) -> Result<(), FrustumError> {
+        let light = &frame.light_from_world;
+        let FittedBox {
+            xy_lo,
+            xy_hi,
+            texel,
+            reach,
+            ..
+        } = *fitted;
         // Light space looks down -Z: distance from the light is -z.
-        let mut near_dist = -hi.z;
-        let far_dist = -lo.z;
+        let (mut near_dist, far_dist) = fitted.depth;
         let mut caster_depth = None;
         if let Some(scene) = &self.scene {
             if let Some((c_near, c_far)) = caster_depth_over(light, &scene.casters, xy_lo, xy_hi)? {
@@ -495,7 +639,8 @@ impl<'a> Fitter<'a> {
                 near_dist = near_dist.min(c_near);
             }
         }
-        let depth_scale = near_dist.abs().max(far_dist.abs()).max(1e-30);
+        // Finite distances (of finite points and bounds): no NaN for `max_num`.
+        let depth_scale = math::max_num(math::max_num(near_dist.abs(), far_dist.abs()), 1e-30);
         let min_thickness = 1e-5 * depth_scale;
         let (near_dist, far_dist) = if far_dist - near_dist < min_thickness {
             let mid = 0.5 * (near_dist + far_dist);
@@ -503,35 +648,62 @@ impl<'a> Fitter<'a> {
         } else {
             (near_dist, far_dist)
         };
-        let clip_from_world = crate::projection::orthographic_times_affine(
-            xy_lo.x,
-            xy_hi.x,
-            xy_lo.y,
-            xy_hi.y,
+        let (scale, offset) = crate::projection::orthographic_rows(
+            xy_lo,
+            xy_hi,
             near_dist,
             far_dist,
             self.options.reversed_z,
-            light,
-        )
-        .as_mat4();
-        if !crate::is_invertible(&clip_from_world, reach.max(depth_scale) as f32) {
+        );
+        let clip_from_world = crate::projection::rows_times_affine(scale, offset, light).as_mat4();
+        // The light frame is a rotation: most fits are invertible by
+        // `ortho_rotation_invertible` at a lower bound of the world scale, without the
+        // general test (and without the slice's world extent).
+        let certain = crate::mapping::ortho_rotation_invertible(
+            scale.truncate(),
+            offset.truncate(),
+            depth_scale.max(reach.unwrap_or(0.0)),
+        );
+        let reach = || reach.unwrap_or_else(|| self.camera.world_rays.max_abs(n, f));
+        if !(certain || crate::is_invertible(&clip_from_world, reach().max(depth_scale) as f32)) {
             return Err(FrustumError::DegenerateFrustum);
         }
         let transform = ShadowTransform::new(
-            self.light_from_world32,
+            frame.light_from_world32,
             clip_from_world,
             self.options.reversed_z,
             LightDirection::Directional(self.light_dir.as_vec3()),
         );
-        Ok(Cascade {
+        *out = Cascade {
             view_depth: (n as f32, f as f32),
             transform,
             texel_world_size: texel as f32,
             light_depth: (near_dist as f32, far_dist as f32),
             caster_depth,
             receivers_missed: false,
-        })
+        };
+        Ok(())
     }
+}
+
+/// The light frame a cascade is fitted in.
+struct Frame {
+    light_from_world: DMat4,
+    /// `light_from_world` in `f32`, as stored in the cascade.
+    light_from_world32: Mat4,
+}
+
+/// A cascade's fitted light-space rectangle and depth range, before the casters.
+struct FittedBox {
+    xy_lo: DVec2,
+    xy_hi: DVec2,
+    /// World size of one texel (the larger side).
+    texel: f64,
+    /// Light-space distances `(near, far)` of the receivers.
+    depth: (f64, f64),
+    /// Largest world coordinate of the fitted points, for the invertibility test
+    /// (`None`: not computed; the slice's extent is then read if the test needs it).
+    reach: Option<f64>,
 }
 
 /// The stable box over the light-space footprint `[lo, hi]` with a ladder of sizes:

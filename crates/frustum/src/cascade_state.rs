@@ -1,43 +1,79 @@
-//! Caller-held state of the stable cascade fit: each cascade's map size, kept across
-//! frames with hysteresis.
+//! Caller-held state of the stable cascade fit: each cascade's map size and
+//! orientation, kept across frames with hysteresis.
 
-use glam::DVec2;
+use glam::{DMat4, DVec2, DVec3, Vec3};
 
-use crate::{FrustumError, MAX_CASCADES};
+use crate::{FrustumError, MAX_CASCADES, math};
 
-/// Margin of a stable cascade's map over the light-space footprint it must cover,
-/// each time its size is (re)chosen: the footprint may grow by this factor as the
-/// camera moves or turns before the size has to change.
-pub const STABLE_HEADROOM: f64 = 1.25;
+/// Largest turn of the camera about the world's up axis (`+Y`, radians) that a
+/// stable cascade's map absorbs without re-sizing: each time a size is (re)chosen,
+/// the map covers the light-space footprint of slice ∩ receivers turned about the
+/// light by up to `STABLE_TURN * |l · Y|` either way (`l` the light direction),
+/// the part of a turn about `Y` that turns the footprint in the light's plane
+/// (the rest moves it, which the snapped map follows by whole texels). 0.1 rad
+/// (about 5.7°) covers a camera that turns a few degrees while it walks; a map
+/// that must cover its footprint in every orientation (the bounding sphere of the
+/// slice, Zhang et al.'s stable fit) costs up to 1.41 times the tight fit on
+/// every axis.
+///
+/// Why turning needs a margin at all: the box of a footprint of extents `L > S`
+/// turned by `a` grows by about `L a` along its short side, which a margin in
+/// proportion to each side's own extent would not cover (a 5:1 footprint turned by
+/// 4° grows by 35% across).
+pub const STABLE_TURN: f64 = 0.1;
 
-/// Largest ratio of a held size to the footprint it covers before the map shrinks.
-/// Shrinking only gives texels back (a map that is too big still covers), so the
-/// band is wider on this side: after a resize the footprint may shrink to
-/// `STABLE_HEADROOM / STABLE_SHRINK_RATIO` (about 0.71) of its size, as it may grow
-/// by [`STABLE_HEADROOM`], before the size changes again.
-pub const STABLE_SHRINK_RATIO: f64 = 1.75;
+/// Margin of a stable cascade's map over its turned footprint (see
+/// [`STABLE_TURN`]) each time its size is (re)chosen: the footprint may grow by
+/// this factor (the slice's depths follow the depth bounds, the camera walks)
+/// before the size has to change. Small, because it is what a stable cascade pays
+/// over the tight fit of the same slice where the camera does not turn.
+pub const STABLE_HEADROOM: f64 = 1.03;
+
+/// Largest ratio of a held size to the size it would be (re)chosen at before the
+/// map shrinks. Shrinking only gives texels back (a map that is too big still
+/// covers), so the band is wider on this side.
+pub const STABLE_SHRINK_RATIO: f64 = 1.5;
+
+/// Smallest sine of the angle between a held orientation's up vector and the light
+/// for the orientation to be kept (the light has turned by less than 60° since it
+/// was chosen); otherwise the map is re-oriented and re-sized.
+const HELD_UP_MIN_SIN: f64 = 0.5;
+
+/// One stable cascade's held map: its extents in light-space units along the
+/// frame's x and y (zero when unset) and the world up vector that orients the frame
+/// about the light.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct HeldMap {
+    side: DVec2,
+    up: Vec3,
+}
 
 /// What the stable cascade fit remembers from one frame to the next: each cascade's
-/// map size in light-space units (per axis), and the cascade count the caller chose.
+/// map extents in light-space units and the up vector that orients its light frame,
+/// and the cascade count the caller chose.
 ///
 /// The stable fit ([`CascadeSet::fit_with_state`](crate::CascadeSet::fit_with_state))
 /// fits each cascade's box to its slice ∩ receivers, as the tight fit does, but keeps
-/// the box's size from the previous frame while it still covers the footprint and is
-/// at most [`STABLE_SHRINK_RATIO`] times too big. Only then does it choose a new size,
-/// [`STABLE_HEADROOM`] times the footprint. While the size is kept the box is
-/// snapped to whole texels of a grid anchored at the light frame's origin, so
-/// the map moves by whole texels and shadow edges do not shimmer; unlike the bounding
-/// sphere of the whole slice (the stateless stable fit of Zhang et al.'s parallel-split
-/// shadow maps, made rotation invariant), the held box spends its texels on the
-/// visible receivers.
+/// the box's extents and orientation from the previous frame while they still cover
+/// the footprint and are at most [`STABLE_SHRINK_RATIO`] times too big. Only then does
+/// it choose new ones, in the orientation the caller asks for this frame
+/// ([`CascadeOptions::up_hint`](crate::CascadeOptions::up_hint)): the footprint's
+/// extents turned by up to [`STABLE_TURN`], times [`STABLE_HEADROOM`]. While the
+/// extents are kept the box is snapped to whole texels of a grid anchored at the
+/// held light frame's origin, so the map moves by whole texels and shadow edges do
+/// not shimmer. Unlike the bounding sphere of the whole slice (the stateless stable
+/// fit of Zhang et al.'s parallel-split shadow maps, made rotation invariant), the
+/// held box spends its texels on the visible receivers, and its orientation is the
+/// one that fits them when it is chosen rather than one fixed in the world (a
+/// footprint at 45° to a world-fixed frame needs a box up to 1.41 times larger).
 ///
-/// A fresh state (`Default`) holds no size: the first frame sizes every cascade.
+/// A fresh state (`Default`) holds nothing: the first frame sizes every cascade.
 /// Use one state per light and view; a changed light direction or resolution
 /// simply re-sizes the cascades that no longer fit.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CascadeState {
-    /// Held map size per cascade (light-space x and y extent); zero when unset.
-    sizes: [DVec2; MAX_CASCADES],
+    /// Held map per cascade.
+    held: [HeldMap; MAX_CASCADES],
     /// Cascade count of the previous frame (0: none), for callers that keep the
     /// count with hysteresis.
     count: usize,
@@ -48,7 +84,10 @@ impl CascadeState {
     #[must_use]
     pub const fn new() -> Self {
         Self {
-            sizes: [DVec2::ZERO; MAX_CASCADES],
+            held: [HeldMap {
+                side: DVec2::ZERO,
+                up: Vec3::ZERO,
+            }; MAX_CASCADES],
             count: 0,
         }
     }
@@ -69,17 +108,31 @@ impl CascadeState {
         *self = Self::new();
     }
 
-    /// The held size of cascade `index` (light-space x and y), `None` when unset.
+    /// The held map extents of cascade `index` (light-space x and y), `None` when
+    /// unset.
     #[must_use]
     pub fn size(&self, index: usize) -> Option<DVec2> {
-        self.sizes
+        self.held
             .get(index)
-            .copied()
-            .filter(|s| s.x > 0.0 && s.y > 0.0)
+            .map(|h| h.side)
+            .filter(|s| s.min_element() > 0.0)
     }
 
-    pub(crate) fn slot(&mut self, index: usize) -> Option<&mut DVec2> {
-        self.sizes.get_mut(index)
+    pub(crate) fn slot(&mut self, index: usize) -> Option<HeldSlot<'_>> {
+        self.held.get_mut(index).map(HeldSlot)
+    }
+}
+
+/// Mutable access to one cascade's held map, for the fit.
+pub(crate) struct HeldSlot<'a>(&'a mut HeldMap);
+
+impl HeldSlot<'_> {
+    /// The held orientation's up vector, when a size is held and the light
+    /// `direction` (unit) has not turned too far from it.
+    fn up_for(&self, direction: DVec3) -> Option<Vec3> {
+        let h = &*self.0;
+        let sin = direction.cross(h.up.as_dvec3()).length();
+        (h.side.min_element() > 0.0 && sin > HELD_UP_MIN_SIN).then_some(h.up)
     }
 }
 
@@ -90,7 +143,8 @@ const SIZE_MANTISSA_BITS: u32 = 6;
 /// [`SIZE_MANTISSA_BITS`]-bit mantissa: at most `2^-6` (1.6%) above `x`. With such a
 /// size and a power-of-two resolution the texel `size / resolution` has a short
 /// mantissa too, so whole-texel offsets `k * texel` stay exact in the `f32` matrices
-/// far from the origin and the snapped map does not drift by fractions of a texel.
+/// far from the origin and the snapped map does not drift by fractions of a texel
+/// (eight bits already drift by `1e-5` texel a frame 130 m from the origin).
 fn short_mantissa_above(x: f64) -> f64 {
     let mask = (1u64 << (52 - SIZE_MANTISSA_BITS)) - 1;
     let bits = x.to_bits();
@@ -101,45 +155,127 @@ fn short_mantissa_above(x: f64) -> f64 {
     }
 }
 
-/// The held size for a footprint of extent `needed` (per axis): the previous size
-/// `held` while it covers `needed` and is at most [`STABLE_SHRINK_RATIO`] times
-/// larger, otherwise `needed * STABLE_HEADROOM` (rounded up to a short mantissa).
-/// Each axis on its own.
-pub(crate) fn hold_size(held: DVec2, needed: DVec2) -> DVec2 {
-    let axis = |h: f64, n: f64| {
-        if h >= n && h <= n * STABLE_SHRINK_RATIO {
-            h
-        } else {
-            short_mantissa_above(n * STABLE_HEADROOM)
-        }
-    };
-    DVec2::new(axis(held.x, needed.x), axis(held.y, needed.y))
+/// The held extents for a footprint whose extents (snap slack included) are
+/// `needed`, and `turned` when turned by up to the allowance (see [`STABLE_TURN`]):
+/// the previous `held` while it covers `needed` and is at most
+/// [`STABLE_SHRINK_RATIO`] times the size it would be chosen at, otherwise that
+/// size, `max(needed, turned) * STABLE_HEADROOM` rounded up to a short mantissa;
+/// and whether `held` was kept.
+fn hold_side(held: DVec2, needed: DVec2, turned: DVec2) -> (DVec2, bool) {
+    let target = turned.max(needed) * STABLE_HEADROOM;
+    if held.cmpge(needed).all() && held.cmple(target * STABLE_SHRINK_RATIO).all() {
+        (held, true)
+    } else {
+        (
+            DVec2::new(
+                short_mantissa_above(target.x),
+                short_mantissa_above(target.y),
+            ),
+            false,
+        )
+    }
 }
 
-/// The stable box over the light-space footprint `[lo, hi]` with a held size:
-/// the needed extent per axis is the footprint's plus one texel of slack on each
-/// side for the snap; the size is kept or renewed by [`hold_size`] (and written back
-/// to `held`), and the centre is snapped to whole texels per axis.
-/// Returns the box and its larger texel side.
-pub(crate) fn held_box(
-    lo: DVec2,
-    hi: DVec2,
-    res: f64,
-    held: &mut DVec2,
-) -> Result<(DVec2, DVec2, f64), FrustumError> {
-    let scale = lo.abs().max(hi.abs()).max_element();
-    // A footprint seen edge-on still gets a box f32 can resolve around it.
-    let needed = ((hi - lo) * (res / (res - 2.0))).max(DVec2::splat(1e-5 * scale));
-    if !(needed.min_element() > 0.0 && needed.is_finite()) {
-        return Err(FrustumError::EmptyBounds);
+/// The light-space footprint of `points` in the frame `light` turned about the
+/// light by up to `phi` either way: the largest extents of the turned points,
+/// sampled at `0, ±phi / 2, ±phi` (over so small a range the extents change
+/// monotonically or peak once).
+fn turned_extent(points: &(impl Iterator<Item = DVec3> + Clone), light: &DMat4, phi: f64) -> DVec2 {
+    let mut out = DVec2::ZERO;
+    for k in -2i32..=2 {
+        let t = phi * f64::from(k) / 2.0;
+        let (sin, cos) = (math::sin(t), math::cos(t));
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for p in points.clone() {
+            let q = light.transform_point3(p).truncate();
+            let r = DVec2::new(q.x * cos - q.y * sin, q.x * sin + q.y * cos);
+            lo = lo.min(r);
+            hi = hi.max(r);
+        }
+        out = out.max(hi - lo);
     }
-    let side = hold_size(*held, needed);
-    *held = side;
-    let texel = side / res;
-    let center = (lo + hi) * 0.5;
-    let snapped = (center / texel).round() * texel;
-    let half = texel * (0.5 * res);
-    Ok((snapped - half, snapped + half, texel.max_element()))
+    out
+}
+
+/// The extents the box must cover for `extent` on a map of `res` texels: one
+/// texel of slack for the snap (which moves the box by at most half a texel either
+/// way), at least an extent `f32` can resolve around the footprint (`scale` its
+/// largest coordinate).
+fn with_slack(extent: DVec2, scale: f64, res: f64) -> Result<DVec2, FrustumError> {
+    // A footprint seen edge-on still gets a box f32 can resolve around it.
+    let needed = (extent * (res / (res - 1.0))).max(DVec2::splat(1e-5 * scale));
+    if needed.min_element() > 0.0 && needed.is_finite() {
+        Ok(needed)
+    } else {
+        Err(FrustumError::EmptyBounds)
+    }
+}
+
+/// A stable cascade's box, chosen by [`held_box`].
+pub(crate) struct HeldBox {
+    /// The light frame (rotation) the box lies in.
+    pub(crate) light_from_world: DMat4,
+    /// The box's light-space corners.
+    pub(crate) lo: DVec2,
+    pub(crate) hi: DVec2,
+    /// Its larger texel side.
+    pub(crate) texel: f64,
+}
+
+/// The stable box of one cascade over the world-space footprint `points` (the
+/// vertices of slice ∩ receivers) for a light travelling along `direction` (unit):
+/// in the held frame with the held extents while they still cover and are not too
+/// big (see [`hold_side`]), otherwise in `frame` (this frame's orientation) with
+/// new extents, written back to `held`. The centre is snapped to whole texels of
+/// the frame's grid.
+pub(crate) fn held_box(
+    points: &(impl Iterator<Item = DVec3> + Clone),
+    direction: DVec3,
+    frame: &DMat4,
+    res: f64,
+    held: &mut HeldSlot<'_>,
+) -> Result<HeldBox, FrustumError> {
+    let phi = STABLE_TURN * direction.y.abs();
+    let fit = |light: DMat4, held: DVec2| -> Result<(HeldBox, DVec2, bool), FrustumError> {
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for p in points.clone() {
+            let q = light.transform_point3(p).truncate();
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+        let scale = lo.abs().max(hi.abs()).max_element();
+        let needed = with_slack(hi - lo, scale, res)?;
+        let turned = with_slack(turned_extent(points, &light, phi), scale, res)?;
+        let (side, kept) = hold_side(held, needed, turned);
+        let texel = side / res;
+        let center = ((lo + hi) * 0.5 / texel).round() * texel;
+        let b = HeldBox {
+            light_from_world: light,
+            lo: center - side * 0.5,
+            hi: center + side * 0.5,
+            texel: texel.max_element(),
+        };
+        Ok((b, side, kept))
+    };
+    if let Some(up) = held.up_for(direction) {
+        let (b, _, kept) = fit(
+            crate::projection::light_rotation(direction, up),
+            held.0.side,
+        )?;
+        if kept {
+            return Ok(b);
+        }
+    }
+    // This frame's orientation, by its y axis (the rotation's second row), stored in
+    // f32 and the frame rebuilt from it, so that the frames that keep it rebuild
+    // exactly the same rotation.
+    let up = DVec3::new(frame.x_axis.y, frame.y_axis.y, frame.z_axis.y).as_vec3();
+    let (b, side, _) = fit(
+        crate::projection::light_rotation(direction, up),
+        DVec2::ZERO,
+    )?;
+    *held.0 = HeldMap { side, up };
+    Ok(b)
 }
 
 #[cfg(test)]
@@ -149,21 +285,52 @@ mod tests {
     #[test]
     fn size_is_kept_inside_the_band_and_renewed_outside() {
         let n = DVec2::new(10.0, 4.0);
-        let first = hold_size(DVec2::ZERO, n);
-        assert!(first.cmpge(n * STABLE_HEADROOM).all());
-        assert!(first.cmple(n * (STABLE_HEADROOM * 1.016)).all());
-        // Grows by 10%: still covered, kept.
-        assert_eq!(hold_size(first, n * 1.1), first);
-        // Grows past the headroom: renewed.
-        let renewed = hold_size(first, n * 1.3);
-        assert!(renewed.cmpge(n * 1.3 * STABLE_HEADROOM).all());
-        // Shrinks to 80%: at most 1.75x too big, kept; to half: renewed.
-        assert_eq!(hold_size(first, n * 0.9), first);
-        assert!(hold_size(first, n * 0.5).cmplt(first).all());
-        // Axes are independent.
-        let mixed = hold_size(first, DVec2::new(10.0, 8.0));
-        assert_eq!(mixed.x, first.x);
-        assert!(mixed.y >= 8.0 * STABLE_HEADROOM);
+        let turned = DVec2::new(10.2, 4.9);
+        let (first, kept) = hold_side(DVec2::ZERO, n, turned);
+        assert!(!kept);
+        // The turned footprint with the headroom, rounded up by less than 2%.
+        let target = turned * STABLE_HEADROOM;
+        assert!(first.cmpge(target).all() && first.cmple(target * 1.016).all());
+        // Grows within the margin: still covered, kept.
+        assert_eq!(hold_side(first, n * 1.02, turned * 1.02), (first, true));
+        assert_eq!(
+            hold_side(first, DVec2::new(10.0, 4.8), turned),
+            (first, true)
+        );
+        // Grows past it: renewed from the new footprint.
+        let (renewed, kept) = hold_side(first, n * 1.3, turned * 1.3);
+        assert!(!kept && renewed.cmpge(turned * 1.3 * STABLE_HEADROOM).all());
+        // Shrinks to 80%: kept; to 60%: the held map is more than 1.5 times the size
+        // it would be chosen at, renewed.
+        assert!(hold_side(first, n * 0.8, turned * 0.8).1);
+        let (smaller, kept) = hold_side(first, n * 0.6, turned * 0.6);
+        assert!(!kept && smaller.cmplt(first).all());
+        // One axis too small renews both.
+        let (both, kept) = hold_side(first, DVec2::new(10.0, 8.0), DVec2::new(10.0, 8.0));
+        assert!(!kept && both.y >= 8.0 * STABLE_HEADROOM && both.x < first.x);
+    }
+
+    #[test]
+    fn a_turned_footprint_needs_its_long_side_times_the_turn_across() {
+        // A 5 x 1 rectangle in the light frame of a light straight down: turned by
+        // phi, its box grows to 5 cos + sin by 5 sin + cos.
+        let light = crate::projection::light_rotation(DVec3::NEG_Y, Vec3::Z);
+        let world = |x: f64, y: f64| light.inverse().transform_point3(DVec3::new(x, y, 0.0));
+        let corners = [
+            world(0.0, 0.0),
+            world(5.0, 0.0),
+            world(5.0, 1.0),
+            world(0.0, 1.0),
+        ];
+        let phi = 0.1;
+        let e = turned_extent(&corners.iter().copied(), &light, phi);
+        let (s, c) = (phi.sin(), phi.cos());
+        assert!((e.x - (5.0 * c + s)).abs() < 1e-9, "{e}");
+        assert!((e.y - (5.0 * s + c)).abs() < 1e-9, "{e}");
+        assert_eq!(
+            turned_extent(&corners.iter().copied(), &light, 0.0),
+            DVec2::new(5.0, 1.0)
+        );
     }
 
     #[test]
@@ -178,21 +345,55 @@ mod tests {
     }
 
     #[test]
-    fn held_box_moves_by_whole_texels_and_covers_the_footprint() {
+    fn held_box_moves_by_whole_texels_covers_the_footprint_and_keeps_its_frame() {
         let res = 512.0;
-        let mut held = DVec2::ZERO;
-        let (lo, hi) = (DVec2::new(-3.2, 7.1), DVec2::new(40.3, 19.9));
-        let (a, b, _) = held_box(lo, hi, res, &mut held).unwrap();
-        assert!(a.cmple(lo).all() && b.cmpge(hi).all());
-        let shift = DVec2::new(1.37, -0.61);
-        let (a2, b2, _) = held_box(lo + shift, hi + shift, res, &mut held).unwrap();
-        assert!(a2.cmple(lo + shift).all() && b2.cmpge(hi + shift).all());
-        assert_eq!(b2 - a2, b - a);
-        let texel = (b - a) / res;
-        let moved = (a2 - a) / texel;
+        let direction = DVec3::new(0.3, -1.0, 0.2).normalize();
+        let frame = crate::projection::light_rotation(direction, Vec3::X);
+        let other = crate::projection::light_rotation(direction, Vec3::Z);
+        let footprint = [
+            DVec3::new(-3.2, 0.0, 7.1),
+            DVec3::new(40.3, 0.0, 19.9),
+            DVec3::new(10.0, 5.0, -4.0),
+            DVec3::new(22.0, 1.0, 30.0),
+        ];
+        let mut state = CascadeState::new();
+        let mut slot = state.slot(0).unwrap();
+        let a = held_box(
+            &footprint.iter().copied(),
+            direction,
+            &frame,
+            res,
+            &mut slot,
+        )
+        .unwrap();
+        let covers = |b: &HeldBox, shift: DVec3| {
+            footprint.iter().all(|p| {
+                let q = b.light_from_world.transform_point3(*p + shift).truncate();
+                q.cmpge(b.lo).all() && q.cmple(b.hi).all()
+            })
+        };
+        assert!(covers(&a, DVec3::ZERO));
+        // Moved: the same frame and size (even when asked for another frame), by
+        // whole texels.
+        let shift = DVec3::new(1.37, -0.2, -0.61);
+        let moved: Vec<DVec3> = footprint.iter().map(|p| *p + shift).collect();
+        let mut slot = state.slot(0).unwrap();
+        let b = held_box(&moved.iter().copied(), direction, &other, res, &mut slot).unwrap();
+        assert!(covers(&b, shift));
+        assert_eq!(b.light_from_world, a.light_from_world);
+        assert_eq!(b.hi - b.lo, a.hi - a.lo);
+        let texel = (a.hi - a.lo) / res;
+        let steps = (b.lo - a.lo) / texel;
         assert!(
-            (moved - moved.round()).abs().max_element() < 1e-9,
-            "{moved}"
+            (steps - steps.round()).abs().max_element() < 1e-9,
+            "{steps}"
         );
+        assert!(state.size(0).is_some() && state.size(1).is_none());
+        // Three times larger: re-sized, in the frame asked for now.
+        let big: Vec<DVec3> = footprint.iter().map(|p| *p * 3.0).collect();
+        let mut slot = state.slot(0).unwrap();
+        let c = held_box(&big.iter().copied(), direction, &other, res, &mut slot).unwrap();
+        assert!((c.light_from_world.y_axis - other.y_axis).length() < 1e-6);
+        assert!(c.texel > 2.0 * a.texel);
     }
 }

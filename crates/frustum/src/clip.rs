@@ -130,7 +130,12 @@ impl FrustumBox<'_> {
 
     fn in_box(&self, p: DVec3) -> bool {
         let (lo, hi) = self.box_with_tolerance();
-        p.cmpge(lo).all() && p.cmple(hi).all()
+        (p.x >= lo.x)
+            & (p.y >= lo.y)
+            & (p.z >= lo.z)
+            & (p.x <= hi.x)
+            & (p.y <= hi.y)
+            & (p.z <= hi.z)
     }
 
     fn in_frustum(&self, p: DVec3) -> bool {
@@ -142,13 +147,20 @@ impl FrustumBox<'_> {
     /// The frustum's corners as triple intersections of its planes (the given corners
     /// where the planes do not meet in a point).
     fn plane_corners(&self) -> [DVec3; 8] {
+        let p = &self.planes;
+        // The cross products of the side, bottom/top and near/far normals, each shared
+        // by the two corners on both planes.
+        let n = |k: usize| p[k].normal;
+        let xy: [[DVec3; 2]; 2] =
+            core::array::from_fn(|x| core::array::from_fn(|y| n(x).cross(n(2 + y))));
+        let yz: [[DVec3; 2]; 2] =
+            core::array::from_fn(|y| core::array::from_fn(|z| n(2 + y).cross(n(4 + z))));
+        let zx: [[DVec3; 2]; 2] =
+            core::array::from_fn(|z| core::array::from_fn(|x| n(4 + z).cross(n(x))));
         core::array::from_fn(|i| {
-            let x = [0, 1, 1, 0][i & 3];
-            let y = 2 + (i >> 1 & 1);
-            let p = &self.planes;
-            let (a, b, c) = (&p[x], &p[y], &p[4 + (i >> 2)]);
-            intersect3(a, b, c, c.normal.cross(a.normal), a.normal.cross(b.normal))
-                .unwrap_or(self.corners[i])
+            let (x, y, z) = ([0, 1, 1, 0][i & 3], i >> 1 & 1, i >> 2);
+            let (a, b, c) = (&p[x], &p[2 + y], &p[4 + z]);
+            intersect3_crossed(a, b, c, yz[y][z], zx[z][x], xy[x][y]).unwrap_or(self.corners[i])
         })
     }
 
@@ -158,24 +170,38 @@ impl FrustumBox<'_> {
     /// other end's distance from that plane) per unit of the edge parameter, so only
     /// crossings within `tol / L` of an end can pass (twice that is tried).
     fn frustum_edges(&self, c: &[DVec3; 8], push: &mut impl FnMut(DVec3)) {
+        let bounds = [self.lo.to_array(), self.hi.to_array()];
         for ((i, j), (end_i, end_j)) in FRUSTUM_EDGES.into_iter().zip(EDGE_END_PLANES) {
             let (p, q) = (c[i], c[j]);
-            let before = -2.0 * self.inside_tol / self.planes[end_i].distance(q);
-            let after = 1.0 + 2.0 * self.inside_tol / self.planes[end_j].distance(p);
+            let (pa, qa) = (p.to_array(), q.to_array());
+            // The range past the ends, needed only for crossings off the edge.
+            let mut range = None;
+            let mut past = || {
+                *range.get_or_insert_with(|| {
+                    (
+                        -2.0 * self.inside_tol / self.planes[end_i].distance(q),
+                        1.0 + 2.0 * self.inside_tol / self.planes[end_j].distance(p),
+                    )
+                })
+            };
             for axis in 0..3 {
-                for v in [self.lo[axis], self.hi[axis]] {
-                    let (dp, dq) = (p[axis] - v, q[axis] - v);
+                for v in [bounds[0][axis], bounds[1][axis]] {
+                    let (dp, dq) = (pa[axis] - v, qa[axis] - v);
                     if dp == dq {
                         continue;
                     }
                     let t = dp / (dp - dq);
                     let on_edge = (0.0..=1.0).contains(&t);
                     // Written so that NaN bounds (an edge of length 0) skip too.
-                    if !(on_edge || (t >= before && t <= after)) {
-                        continue;
+                    if !on_edge {
+                        let (before, after) = past();
+                        if !(t >= before && t <= after) {
+                            continue;
+                        }
                     }
-                    let mut x = p + (q - p) * t;
+                    let mut x = (p + (q - p) * t).to_array();
                     x[axis] = v;
+                    let x = DVec3::from(x);
                     if self.in_box(x) && (on_edge || self.in_frustum(x)) {
                         push(x);
                     }
@@ -188,11 +214,14 @@ impl FrustumBox<'_> {
     /// (past the edge's ends, by at most twice the tolerance) the box. The distances
     /// of a point of the edge to the frustum planes are interpolated from its ends'.
     fn box_edges(&self, bc: &[DVec3; 8], dist: &[[f64; 6]; 8], push: &mut impl FnMut(DVec3)) {
+        let (lo, hi) = (self.lo.to_array(), self.hi.to_array());
         for axis in 0..3 {
-            let slack = 2.0 * self.inside_tol / (self.hi[axis] - self.lo[axis]);
+            let slack = 2.0 * self.inside_tol / (hi[axis] - lo[axis]);
             for i in (0..8).filter(|i| i & 1 << axis == 0) {
                 let j = i | 1 << axis;
-                for (di, dj) in dist[i].iter().zip(&dist[j]) {
+                let (dist_i, dist_j) = (&dist[i], &dist[j]);
+                for k in 0..6 {
+                    let (di, dj) = (dist_i[k], dist_j[k]);
                     if di == dj {
                         continue;
                     }
@@ -200,13 +229,15 @@ impl FrustumBox<'_> {
                     if !(t >= -slack && t <= 1.0 + slack) {
                         continue;
                     }
-                    let inside = dist[i]
-                        .iter()
-                        .zip(&dist[j])
-                        .all(|(a, b)| a + (b - a) * t >= -self.inside_tol);
+                    let inside = (0..6).all(|m| {
+                        let (a, b) = (dist_i[m], dist_j[m]);
+                        a + (b - a) * t >= -self.inside_tol
+                    });
                     if inside {
-                        let mut x = bc[i];
-                        x[axis] += (bc[j][axis] - bc[i][axis]) * t;
+                        let (a, b) = (bc[i].to_array(), bc[j].to_array());
+                        let mut x = a;
+                        x[axis] += (b[axis] - a[axis]) * t;
+                        let x = DVec3::from(x);
                         if self.in_box(x) {
                             push(x);
                         }
@@ -270,7 +301,18 @@ pub(crate) fn intersect3(
     ca: DVec3,
     ab: DVec3,
 ) -> Option<DVec3> {
-    let bc = b.normal.cross(c.normal);
+    intersect3_crossed(a, b, c, b.normal.cross(c.normal), ca, ab)
+}
+
+/// [`intersect3`] with all three cross products given (`bc = b × c` as well).
+fn intersect3_crossed(
+    a: &DPlane,
+    b: &DPlane,
+    c: &DPlane,
+    bc: DVec3,
+    ca: DVec3,
+    ab: DVec3,
+) -> Option<DVec3> {
     let det = a.normal.dot(bc);
     if det.abs() < 1e-12 {
         return None;

@@ -96,6 +96,9 @@ mod mapping;
 pub mod math;
 mod predict;
 pub mod projection;
+mod rays;
+mod scene_bounds;
+mod selector;
 mod split;
 mod spot;
 mod valid;
@@ -107,10 +110,8 @@ mod serde_impls;
 
 pub use body::{ConvexBody, MAX_BODY_VERTICES};
 pub use camera::{Camera, Projection};
-pub use cascade::{
-    Cascade, CascadeFit, CascadeOptions, CascadeSet, MAX_RESOLUTION, SceneBounds, fit_cascade,
-};
-pub use cascade_state::{CascadeState, STABLE_HEADROOM, STABLE_SHRINK_RATIO};
+pub use cascade::{Cascade, CascadeFit, CascadeOptions, CascadeSet, fit_cascade};
+pub use cascade_state::{CascadeState, STABLE_HEADROOM, STABLE_SHRINK_RATIO, STABLE_TURN};
 pub use clip::MAX_FRUSTUM_AABB_VERTICES;
 pub use depth_bounds::DepthBounds;
 pub use error::FrustumError;
@@ -122,8 +123,10 @@ pub use mapping::{
 };
 pub use predict::{
     FRONT_LIT_MIN_COS, MAX_PREDICT_CANDIDATES, MAX_PREDICT_RAYS, PredictOptions, PredictedError,
-    TechniqueSelector, predict_error, predict_errors,
+    predict_error, predict_errors,
 };
+pub use scene_bounds::{MAX_RESOLUTION, SceneBounds};
+pub use selector::TechniqueSelector;
 pub use split::{CascadeBlend, CascadeSplits, MAX_CASCADES, SplitScheme};
 pub use spot::{SpotShadow, fit_spot};
 pub use valid::ValidCamera;

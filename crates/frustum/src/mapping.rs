@@ -11,6 +11,16 @@ pub const UV_FROM_CLIP: Mat4 = Mat4::from_cols(
     Vec4::new(0.5, 0.5, 0.0, 1.0),
 );
 
+/// [`UV_FROM_CLIP`] times `m`, row by row: `u = (x + w) / 2`, `v = (w - y) / 2`, as
+/// the product computes them (its other terms are exact zeros) in a quarter of the
+/// operations.
+fn uv_from_clip_times(m: &Mat4) -> Mat4 {
+    let col = |c: Vec4| {
+        c * Vec4::new(0.5, -0.5, 1.0, 1.0) + Vec4::splat(c.w) * Vec4::new(0.5, 0.5, 0.0, 0.0)
+    };
+    Mat4::from_cols(col(m.x_axis), col(m.y_axis), col(m.z_axis), col(m.w_axis))
+}
+
 /// Where a world point lands in a shadow map: texture coordinates, depth and layer.
 ///
 /// `f64` so that the evaluation harness can take accurate Jacobians.
@@ -69,6 +79,7 @@ pub struct ShadowTransform {
 impl ShadowTransform {
     /// The transform for a depth-pass matrix; computes `uv_from_world`.
     #[must_use]
+    #[inline]
     pub fn new(
         light_from_world: Mat4,
         clip_from_world: Mat4,
@@ -78,7 +89,7 @@ impl ShadowTransform {
         Self {
             light_from_world,
             clip_from_world,
-            uv_from_world: UV_FROM_CLIP * clip_from_world,
+            uv_from_world: uv_from_clip_times(&clip_from_world),
             reversed_z,
             light,
         }
@@ -139,30 +150,76 @@ impl ShadowMapping for ShadowTransform {
 /// row equal to the `w` row for a tiny near plane far from the origin; scaling by the
 /// world's magnitude keeps the test independent of the world's units.
 pub fn is_invertible(m: &Mat4, world_scale: f32) -> bool {
-    let a = m.to_cols_array();
-    if !a.iter().all(|x| x.is_finite()) {
+    use glam::Vec4Swizzles;
+    if !m.is_finite() {
         return false;
     }
-    let d = a.map(f64::from);
+    let d = m.as_dmat4();
     let s = f64::from(world_scale.abs()).max(f64::MIN_POSITIVE);
-    // Row `r` of the column-major matrix is `d[r], d[4 + r], d[8 + r], d[12 + r]`.
-    let rows: [glam::DVec4; 4] =
-        core::array::from_fn(|r| glam::DVec4::new(d[r] * s, d[4 + r] * s, d[8 + r] * s, d[12 + r]));
-    let norms = rows.map(glam::DVec4::length_squared);
-    if norms.contains(&0.0) {
+    let s2 = s * s;
+    // The Gram matrix of the scaled rows, `sum_c w_c col_c col_c^T` over the columns
+    // (`w_c = s²` for x, y, z and 1 for the translation): its diagonal holds the
+    // rows' squared norms, `pairs` the dot products of rows (0, 1), (0, 2), (0, 3),
+    // (1, 2) and `pairs_3` those of rows (1, 3), (2, 3).
+    let w = d.w_axis;
+    let (mut norms, mut pairs, mut pairs_3) = (w * w, w.xxxy() * w.yzwz(), w.yz() * w.ww());
+    for c in [d.x_axis, d.y_axis, d.z_axis] {
+        norms += c * c * s2;
+        pairs += c.xxxy() * c.yzwz() * s2;
+        pairs_3 += c.yz() * c.ww() * s2;
+    }
+    if norms.cmpeq(glam::DVec4::ZERO).any() {
         return false;
     }
-    for i in 0..4 {
-        for j in i + 1..4 {
-            let dot = rows[i].dot(rows[j]);
-            // sin² of the angle between the rows.
-            if 1.0 - dot * dot / (norms[i] * norms[j]) < 1e-12 {
-                return false;
-            }
-        }
+    let dots = [pairs.x, pairs.y, pairs.z, pairs.w, pairs_3.x, pairs_3.y];
+    let products = [
+        norms.x * norms.y,
+        norms.x * norms.z,
+        norms.x * norms.w,
+        norms.y * norms.z,
+        norms.y * norms.w,
+        norms.z * norms.w,
+    ];
+    // sin² of the angle between two rows below 1e-12, without a division.
+    if dots
+        .iter()
+        .zip(&products)
+        .any(|(dot, nn)| nn - dot * dot < 1e-12 * nn)
+    {
+        return false;
     }
-    let det = DMat4::from_cols_array(&d).determinant();
+    let det = d.determinant();
     det != 0.0 && det.is_finite()
+}
+
+/// Whether [`is_invertible`] accepts, for every world scale of at least
+/// `world_scale`, the `f32` rounding of an orthographic projection (row scales
+/// `scale`, offsets `offset`, see `projection::orthographic_rows`) times a rotation,
+/// decided from those six numbers alone. `false` means "not certain": run
+/// [`is_invertible`] on the matrix.
+///
+/// Why `true` is certain: the rounded matrix has rows `(a_i (R_i + e_i), o_i)`
+/// (`R_i` orthonormal, `|e_i| <= 2^-23` while `1e-30 <= |a_i| <= 1e30`, so no entry
+/// leaves the normal range by more than rounding) and the exact last row `(0, 0, 0, 1)`.
+/// Scaled by the world scale `s`, with `u_i = o_i / (s a_i)` and `|u_i| <= 64`:
+///
+/// ```text
+/// rows i, j < 3:  cos <= 4e-7 + |u_i u_j| / sqrt((1 + u_i²)(1 + u_j²)) <= 1 - 2e-4
+/// rows i, 3:      sin² = 1 / (1 + u_i²) >= 2e-4
+/// det = det of the 3x3 block = a_0 a_1 a_2 det(R + E), |det(R + E)| >= 0.99
+/// ```
+///
+/// so every pair of rows is far from parallel (`sin² >= 1e-4 > 1e-12`), the
+/// determinant is finite and non-zero, and `1e-60 <= s |a_i| <= 1e60` keeps the
+/// squared norms and their products finite and non-zero.
+pub(crate) fn ortho_rotation_invertible(scale: DVec3, offset: DVec3, world_scale: f64) -> bool {
+    // One row at a time, every comparison false for NaN.
+    let row = |a: f64, o: f64| {
+        let (a, o) = (a.abs(), o.abs());
+        let sa = a * world_scale;
+        (1e-30..=1e30).contains(&a) & (1e-60..=1e60).contains(&sa) & (o <= 1e30) & (o <= 64.0 * sa)
+    };
+    row(scale.x, offset.x) & row(scale.y, offset.y) & row(scale.z, offset.z)
 }
 
 pub(crate) fn project_dmat(uv_from_world: &DMat4, p: DVec3) -> Option<ShadowSample> {
@@ -195,4 +252,56 @@ pub(crate) fn uv_jacobian_singular_values(m: &DMat4, p: DVec3) -> Option<(f64, f
     let (l1, l2) = (mean + disc, (mean - disc).max(0.0));
     let (s1, s2) = (math::sqrt(l1), math::sqrt(l2));
     (s1.is_finite() && s2 > 0.0).then_some((s1, s2))
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec3, Vec3};
+    use proptest::prelude::*;
+
+    use super::{is_invertible, ortho_rotation_invertible};
+    use crate::projection::{light_rotation, orthographic_rows, rows_times_affine};
+
+    /// `10^e` for a generated exponent: magnitudes from tiny to huge.
+    fn magnitude(e: f64) -> f64 {
+        10f64.powf(e)
+    }
+
+    proptest! {
+        #![proptest_config(shadowmap_testgen::proptest_config())]
+
+        /// Where `ortho_rotation_invertible` is certain, `is_invertible` agrees at
+        /// that world scale and above; and an ordinary fit is decided without it.
+        #[test]
+        fn ortho_rotation_invertible_implies_is_invertible(
+            dir in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+            center in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+            e_center in -40.0f64..40.0,
+            e_size in (-40.0f64..40.0, -40.0f64..40.0, -40.0f64..40.0),
+            e_scale in -40.0f64..40.0,
+            reversed_z: bool,
+        ) {
+            let Some(dir) = DVec3::new(dir.0, dir.1, dir.2).try_normalize() else {
+                return Ok(());
+            };
+            let rotation = light_rotation(dir, Vec3::Y);
+            let c = DVec3::new(center.0, center.1, center.2) * magnitude(e_center);
+            let half = DVec3::new(magnitude(e_size.0), magnitude(e_size.1), magnitude(e_size.2));
+            let (lo, hi) = (c - half, c + half);
+            let (scale, offset) =
+                orthographic_rows(lo.truncate(), hi.truncate(), lo.z, hi.z, reversed_z);
+            let m = rows_times_affine(scale, offset, &rotation).as_mat4();
+            let world = magnitude(e_scale);
+            if ortho_rotation_invertible(scale.truncate(), offset.truncate(), world) {
+                for s in [world, world * 3.0, world * 1e6] {
+                    prop_assert!(is_invertible(&m, s as f32), "{m:?} at {s}");
+                }
+            }
+            // A box of ordinary size around points at most its world scale away.
+            let (lo, hi) = (DVec3::new(-3.0, 1.0, -50.0), DVec3::new(7.0, 12.0, -0.5));
+            let (scale, offset) =
+                orthographic_rows(lo.truncate(), hi.truncate(), lo.z, hi.z, reversed_z);
+            prop_assert!(ortho_rotation_invertible(scale.truncate(), offset.truncate(), 50.0));
+        }
+    }
 }

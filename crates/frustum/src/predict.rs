@@ -1,6 +1,6 @@
 //! Predicted aliasing error of a shadow mapping, from the camera and the receivers'
 //! bounds alone: no rendering, no allocation. It lets a renderer choose a technique per
-//! frame ([`TechniqueSelector`]) before drawing anything.
+//! frame ([`TechniqueSelector`](crate::TechniqueSelector)) before drawing anything.
 //!
 //! The receivers' box stands in for the unknown surfaces: a grid of view rays is cast
 //! through the frustum, and each ray stops where it first meets a face of the box (the
@@ -15,7 +15,14 @@
 //! m = 1 / s_min(J)            the largest extent of a texel, in pixels (1: matched)
 //! ```
 //!
-//! and the prediction is a percentile of `m` over the rays that meet the box (the
+//! Where the visible depth range is known (a depth reduction,
+//! [`PredictOptions::depth_range`]), each ray's point is kept within it: a face that
+//! lies nearer or farther than anything visible is not what the pixel sees, and the
+//! ray then stands for the worst of a few points over its visible stretch, facing
+//! as the face does (the receivers' box of a terrain reaches below and beyond the
+//! ground the camera sees, and its top lies at the tree tops).
+//!
+//! The prediction is a percentile of `m` over the rays that meet the box (the
 //! quality report ranks techniques by the 95th percentile of the same quantity over
 //! the rendered pixels). Rays whose neighbours fall into another map layer (a cascade
 //! boundary) or outside the map are left out.
@@ -48,6 +55,15 @@ pub struct PredictOptions {
     /// them would rank techniques by surfaces nobody sees shadowed. When no ray
     /// meets a front-lit face, every ray counts. Default `None` (every ray).
     pub light_direction: Option<Vec3>,
+    /// View depths `(near, far)` of the visible surfaces, if known (a depth
+    /// reduction, see `DepthBounds`). Each ray's point is kept inside this range:
+    /// a face met nearer than `near` or farther than `far` is not what the pixel
+    /// sees (the receivers' box is only a bound), so the ray's error is the largest
+    /// at a few points over the stretch of it inside the box and the range, facing
+    /// as the face does (where along the ray the surface lies is unknown: the
+    /// prediction takes the worst the bounds allow); a ray whose segment in the box
+    /// lies wholly outside the range is left out. Default `None`.
+    pub depth_range: Option<(f32, f32)>,
 }
 
 /// Smallest `n · l` of a face that counts as lit (see
@@ -70,7 +86,17 @@ impl PredictOptions {
             grid_rows: 9,
             percentile: 0.95,
             light_direction: None,
+            depth_range: None,
         }
+    }
+
+    /// Sets [`depth_range`](Self::depth_range) (`near < far`, both finite and
+    /// positive, else none).
+    #[must_use]
+    pub fn with_depth_range(mut self, near: f32, far: f32) -> Self {
+        let ok = near.is_finite() && far.is_finite() && near > 0.0 && far > near;
+        self.depth_range = ok.then_some((near, far));
+        self
     }
 
     /// Sets [`light_direction`](Self::light_direction) (a zero or non-finite
@@ -110,7 +136,10 @@ impl PredictOptions {
             && rays <= MAX_PREDICT_RAYS as u64
             && self.percentile > 0.0
             && self.percentile <= 1.0
-            && self.light_direction.is_none_or(Vec3::is_finite);
+            && self.light_direction.is_none_or(Vec3::is_finite)
+            && self
+                .depth_range
+                .is_none_or(|(n, f)| n.is_finite() && f.is_finite() && n > 0.0 && f > n);
         if ok {
             Ok(())
         } else {
@@ -186,11 +215,12 @@ pub fn predict_errors(
     if !(receivers.is_finite() && receivers.is_valid()) {
         return Err(FrustumError::EmptyBounds);
     }
-    let screen = Screen::new(camera, options.viewport_height)?;
     let toward_light = options
         .light_direction
         .and_then(Vec3::try_normalize)
         .map(|d| -d.as_dvec3());
+    let screen =
+        Screen::new(camera, options.viewport_height)?.with_depth_range(options.depth_range);
     let mut errors = [[0.0f64; MAX_PREDICT_RAYS]; MAX_PREDICT_CANDIDATES];
     let mut counts = [0usize; MAX_PREDICT_CANDIDATES];
     // Front-lit shared rays first (without a light: every shared ray, twice); then
@@ -242,20 +272,21 @@ impl Pass<'_> {
                     (f64::from(column) + 0.5) / f64::from(columns),
                     (f64::from(row) + 0.5) / f64::from(rows),
                 );
-                let Some((point, normal)) = self.screen.hit(at, self.receivers) else {
+                let Some(hit) = self.screen.hit(at, self.receivers) else {
                     continue;
                 };
                 if self
                     .lit_by
-                    .is_some_and(|l| normal.dot(l) < FRONT_LIT_MIN_COS)
+                    .is_some_and(|l| hit.normal().dot(l) < FRONT_LIT_MIN_COS)
                 {
                     continue;
                 }
                 let mut ray = [None; MAX_PREDICT_CANDIDATES];
                 for (m, &(mapping, side)) in ray.iter_mut().zip(candidates) {
-                    *m = self
-                        .screen
-                        .error_at(at, point, normal, mapping, f64::from(side));
+                    *m = hit.error(|point, normal| {
+                        self.screen
+                            .error_at(at, point, normal, mapping, f64::from(side))
+                    });
                 }
                 if self.shared && ray[..n].iter().any(Option::is_none) {
                     continue;
@@ -266,6 +297,43 @@ impl Pass<'_> {
                         counts[i] += 1;
                     }
                 }
+            }
+        }
+    }
+}
+
+/// Points of a ray moved into the visible depth range (see [`Screen::hit`]).
+const DEPTH_POINTS: usize = 4;
+
+/// What a ray of the prediction meets.
+enum Hit {
+    /// A face of the receivers' box: the point and the face's normal.
+    Face(DVec3, DVec3),
+    /// No face within the visible depth range: points over the range along the ray,
+    /// and the normal they face.
+    Range([DVec3; DEPTH_POINTS], DVec3),
+}
+
+impl Hit {
+    fn normal(&self) -> DVec3 {
+        match self {
+            Self::Face(_, n) | Self::Range(_, n) => *n,
+        }
+    }
+
+    /// The error of the ray from `error_at(point, normal)`: at the face, or the
+    /// largest over the points in range (where on the ray the surface lies is
+    /// unknown: the prediction takes the worst the depth bounds allow); `None` if
+    /// any point is not covered.
+    fn error(&self, mut error_at: impl FnMut(DVec3, DVec3) -> Option<f64>) -> Option<f64> {
+        match self {
+            Self::Face(p, n) => error_at(*p, *n),
+            Self::Range(points, n) => {
+                let mut worst = 0.0f64;
+                for p in points {
+                    worst = worst.max(error_at(*p, *n)?);
+                }
+                Some(worst)
             }
         }
     }
@@ -291,8 +359,14 @@ fn summarize(errors: &mut [f64], percentile: f64) -> Option<PredictedError> {
 struct Screen {
     near: [DVec3; 4],
     far: [DVec3; 4],
+    /// View depths of the near and far planes.
+    near_depth: f64,
+    far_depth: f64,
     /// One pixel in normalized screen units, `(1 / width, 1 / height)`.
     pixel: DVec2,
+    /// The range of the ray parameter `s` (0 at the near plane, 1 at the far plane)
+    /// where the visible surfaces lie ([`PredictOptions::depth_range`]), if given.
+    visible: Option<(f64, f64)>,
 }
 
 impl Screen {
@@ -308,11 +382,27 @@ impl Screen {
         if !(width.is_finite() && aspect > 0.0) {
             return Err(FrustumError::DegenerateFrustum);
         }
+        let (near_depth, far_depth) = camera.depth_range()?;
         Ok(Self {
             near,
             far,
+            near_depth: f64::from(near_depth),
+            far_depth: f64::from(far_depth),
             pixel: DVec2::new(1.0 / width, 1.0 / height),
+            visible: None,
         })
+    }
+
+    /// With the visible depth range `range` (view depths; the rays run from the
+    /// near plane, `s = 0`, to the far plane, `s = 1`, so view depth is linear in
+    /// `s`).
+    fn with_depth_range(mut self, range: Option<(f32, f32)>) -> Self {
+        let (zn, zf) = (self.near_depth, self.far_depth);
+        if let Some((lo, hi)) = range.filter(|_| zf > zn) {
+            let s = |z: f32| (f64::from(z) - zn) / (zf - zn);
+            self.visible = Some((s(lo).max(0.0), s(hi).min(1.0)));
+        }
+        self
     }
 
     /// The ray through normalized screen position `at` (`(0, 0)` bottom left): the
@@ -327,10 +417,38 @@ impl Screen {
         (origin, bilerp(&self.far) - origin)
     }
 
-    /// Where the ray through `at` first meets the box, and that face's normal.
-    fn hit(&self, at: DVec2, receivers: &Aabb) -> Option<(DVec3, DVec3)> {
+    /// Where the ray through `at` first meets the box inside the visible depth
+    /// range: the face point and its normal, or, where that face lies outside the
+    /// range (see [`PredictOptions::depth_range`]), [`DEPTH_POINTS`] points
+    /// log-spaced in depth over the part of the ray in the box and in range, facing
+    /// as that face does (the box's faces stand for the surfaces' orientation: the
+    /// ground under a box whose floor lies below it, the walls of a street).
+    fn hit(&self, at: DVec2, receivers: &Aabb) -> Option<Hit> {
         let (origin, step) = self.ray(at);
-        first_face_hit(origin, step, receivers)
+        let (s, segment, normal) = first_face_hit(origin, step, receivers)?;
+        let Some(visible) = self.visible else {
+            // Without a depth range, the face the ray meets between the camera's
+            // planes.
+            return (0.0..=1.0)
+                .contains(&s)
+                .then(|| Hit::Face(origin + step * s, normal));
+        };
+        let (lo, hi) = (segment.0.max(visible.0), segment.1.min(visible.1));
+        if !(lo <= hi) {
+            return None;
+        }
+        if (lo..=hi).contains(&s) {
+            return Some(Hit::Face(origin + step * s, normal));
+        }
+        // View depth is linear in `s`: log-spaced depths are log-spaced in
+        // `s + s0`, `s0 = zn / (zf - zn)`.
+        let s0 = self.near_depth / (self.far_depth - self.near_depth);
+        let (a, b) = (math::ln(lo + s0), math::ln(hi + s0));
+        let points = core::array::from_fn(|k| {
+            let t = (k as f64 + 0.5) / DEPTH_POINTS as f64;
+            origin + step * (math::exp(a + (b - a) * t) - s0)
+        });
+        Some(Hit::Range(points, normal))
     }
 
     /// `m` at `point` on the face with `normal` met by the ray through `at`, if the
@@ -365,9 +483,10 @@ impl Screen {
     }
 }
 
-/// Where the segment `origin + s step`, `s` in `[0, 1]`, first meets a face of the box,
-/// and that face's normal turned toward the segment's start.
-fn first_face_hit(origin: DVec3, step: DVec3, b: &Aabb) -> Option<(DVec3, DVec3)> {
+/// Where the segment `origin + s step`, `s` in `[0, 1]`, first meets a face of the box
+/// (the parameter `s`), the part of the segment inside the box, and that face's
+/// normal turned toward the segment's start.
+fn first_face_hit(origin: DVec3, step: DVec3, b: &Aabb) -> Option<(f64, (f64, f64), DVec3)> {
     let (lo, hi) = (b.min.as_dvec3(), b.max.as_dvec3());
     let (mut enter, mut exit) = (f64::NEG_INFINITY, f64::INFINITY);
     let (mut enter_axis, mut exit_axis) = (None, None);
@@ -399,12 +518,9 @@ fn first_face_hit(origin: DVec3, step: DVec3, b: &Aabb) -> Option<(DVec3, DVec3)
     } else {
         (exit, exit_axis?)
     };
-    if !(0.0..=1.0).contains(&s) {
-        return None;
-    }
     let mut normal = DVec3::ZERO;
     normal[axis] = -step[axis].signum();
-    Some((origin + step * s, normal))
+    Some((s, (enter.max(0.0), exit.min(1.0)), normal))
 }
 
 /// Where the line `origin + s dir` meets the plane through `point` with `normal`.
@@ -416,67 +532,6 @@ fn plane_hit(origin: DVec3, dir: DVec3, point: DVec3, normal: DVec3) -> Option<D
     let s = normal.dot(point - origin) / denom;
     let p = origin + dir * s;
     p.is_finite().then_some(p)
-}
-
-/// Chooses among candidate techniques by predicted error, with hysteresis: the current
-/// choice is kept until another candidate's prediction is lower by more than
-/// [`switch_margin`](Self::switch_margin) (relative), so the choice does not flip
-/// every frame when two candidates are close. Keep one per light across frames.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct TechniqueSelector {
-    /// The index chosen last, if any.
-    pub current: Option<usize>,
-    /// Relative improvement needed to switch. Default 0.1.
-    pub switch_margin: f64,
-}
-
-impl Default for TechniqueSelector {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl TechniqueSelector {
-    /// No choice yet; a 10% margin.
-    #[must_use]
-    pub const fn new() -> Self {
-        Self {
-            current: None,
-            switch_margin: 0.1,
-        }
-    }
-
-    /// Sets [`switch_margin`](Self::switch_margin) (negative or NaN: 0).
-    #[must_use]
-    pub const fn with_switch_margin(mut self, margin: f64) -> Self {
-        self.switch_margin = margin;
-        self
-    }
-
-    /// Picks the index of the lowest prediction (`None` entries are candidates that
-    /// could not be fitted or predicted), keeping the current choice unless the best
-    /// beats it by the margin. `None` when no candidate has a prediction. Ties go to
-    /// the lower index, so list candidates from the most to the least preferred.
-    pub fn choose(&mut self, predictions: &[Option<f64>]) -> Option<usize> {
-        let best = predictions
-            .iter()
-            .enumerate()
-            .filter_map(|(i, p)| p.filter(|v| v.is_finite()).map(|v| (i, v)))
-            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))?;
-        let margin = if self.switch_margin > 0.0 {
-            self.switch_margin
-        } else {
-            0.0
-        };
-        let keep = self
-            .current
-            .and_then(|i| predictions.get(i).copied().flatten().map(|v| (i, v)))
-            .filter(|(_, v)| v.is_finite() && best.1 >= *v * (1.0 - margin));
-        let (index, _) = keep.unwrap_or(best);
-        self.current = Some(index);
-        Some(index)
-    }
 }
 
 #[cfg(test)]
@@ -649,22 +704,39 @@ mod tests {
         );
     }
 
+    /// A mapping that covers only view depths in `[near, far]` (the camera of
+    /// `camera()` looks down `-Z` from `z = 0`).
+    struct DepthOnly(ShadowTransform, f64, f64);
+
+    impl ShadowMapping for DepthOnly {
+        fn map_point(&self, world: glam::DVec3) -> Option<crate::ShadowSample> {
+            (-world.z >= self.1 && -world.z <= self.2)
+                .then(|| self.0.map_point(world))
+                .flatten()
+        }
+    }
+
     #[test]
-    fn the_selector_switches_only_past_its_margin() {
-        let mut s = TechniqueSelector::new();
-        assert_eq!(s.choose(&[None, None]), None);
-        assert_eq!(s.choose(&[Some(2.0), Some(1.0)]), Some(1));
-        // 0 is now 5% better than 1: not enough to switch.
-        assert_eq!(s.choose(&[Some(0.95), Some(1.0)]), Some(1));
-        // 20% better: switch.
-        assert_eq!(s.choose(&[Some(0.8), Some(1.0)]), Some(0));
-        // The current one disappears: take the best.
-        assert_eq!(s.choose(&[None, Some(3.0), Some(2.0)]), Some(2));
-        // NaN predictions never win; ties go to the lower index.
-        let mut fresh = TechniqueSelector::new().with_switch_margin(f64::NAN);
-        assert_eq!(
-            fresh.choose(&[Some(f64::NAN), Some(1.0), Some(1.0)]),
-            Some(1)
-        );
+    fn points_stay_within_the_depth_bounds() {
+        let (c, g, map) = (camera(), ground(), overhead(250.0));
+        let slab = DepthOnly(map, 20.0, 40.0);
+        let o = PredictOptions::default().with_light_direction(Vec3::NEG_Y);
+        let mut out = [None; 2];
+        // Without bounds most rays meet the box outside the slab.
+        predict_errors(&c, &g, &[(&map, 1024), (&slab, 1024)], &o, &mut out).unwrap();
+        let unbounded = out[0].unwrap();
+        // With them, every point lies in it: the slab covers every ray the map does.
+        let bounded = o.with_depth_range(20.0, 40.0);
+        predict_errors(&c, &g, &[(&map, 1024), (&slab, 1024)], &bounded, &mut out).unwrap();
+        let (all, inside) = (out[0].unwrap(), out[1].unwrap());
+        assert_eq!(all, inside);
+        assert!(all.rays > unbounded.rays, "{all:?} vs {unbounded:?}");
+        // Invalid bounds are none.
+        assert_eq!(o.with_depth_range(40.0, 20.0).depth_range, None);
+        assert_eq!(o.with_depth_range(0.0, 20.0).depth_range, None);
+        assert_eq!(o.with_depth_range(f32::NAN, 20.0).depth_range, None);
+        // Bounds beyond the far plane leave no ray.
+        let beyond = o.with_depth_range(250.0, 300.0);
+        assert_eq!(predict_error(&c, &ground(), &map, 1024, &beyond), Ok(None));
     }
 }

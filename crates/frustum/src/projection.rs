@@ -12,7 +12,7 @@
 //! Reversed-Z swaps the roles of `n` and `f` in the depth row, giving depth 1 at the
 //! near plane and 0 at the far plane.
 
-use glam::{DMat4, DVec3, DVec4, Vec3};
+use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
 
 use crate::math;
 
@@ -28,13 +28,13 @@ pub fn orthographic(
     far: f64,
     reversed_z: bool,
 ) -> DMat4 {
-    let (n, f) = if reversed_z { (far, near) } else { (near, far) };
-    let rcp = 1.0 / (n - f);
+    let (scale, offset) =
+        orthographic_rows(DVec2::new(l, b), DVec2::new(r, t), near, far, reversed_z);
     DMat4::from_cols(
-        DVec4::new(2.0 / (r - l), 0.0, 0.0, 0.0),
-        DVec4::new(0.0, 2.0 / (t - b), 0.0, 0.0),
-        DVec4::new(0.0, 0.0, rcp, 0.0),
-        DVec4::new(-(r + l) / (r - l), -(t + b) / (t - b), rcp * n, 1.0),
+        DVec4::new(scale.x, 0.0, 0.0, 0.0),
+        DVec4::new(0.0, scale.y, 0.0, 0.0),
+        DVec4::new(0.0, 0.0, scale.z, 0.0),
+        offset,
     )
 }
 
@@ -54,17 +54,38 @@ pub fn orthographic_times_affine(
     reversed_z: bool,
     light_from_affine: &DMat4,
 ) -> DMat4 {
-    let (n, f) = if reversed_z { (far, near) } else { (near, far) };
-    let rcp = 1.0 / (n - f);
-    let scale = DVec4::new(2.0 / (r - l), 2.0 / (t - b), rcp, 0.0);
-    let offset = DVec4::new(-(r + l) / (r - l), -(t + b) / (t - b), rcp * n, 1.0);
-    let m = light_from_affine;
+    let (scale, offset) =
+        orthographic_rows(DVec2::new(l, b), DVec2::new(r, t), near, far, reversed_z);
+    rows_times_affine(scale, offset, light_from_affine)
+}
+
+/// The orthographic matrix of rows `scale`, `offset` ([`orthographic_rows`]) times
+/// the affine `m`.
+pub(crate) fn rows_times_affine(scale: DVec4, offset: DVec4, m: &DMat4) -> DMat4 {
     DMat4::from_cols(
         m.x_axis * scale,
         m.y_axis * scale,
         m.z_axis * scale,
         m.w_axis * scale + offset,
     )
+}
+
+/// The rows of `orthographic(lo.x, hi.x, lo.y, hi.y, near, far, reversed_z)` as a
+/// scale and an offset: clip coordinate `i` of a point `p` is
+/// `scale[i] * p[i] + offset[i]` (`w`: scale 0, offset 1).
+pub(crate) fn orthographic_rows(
+    lo: DVec2,
+    hi: DVec2,
+    near: f64,
+    far: f64,
+    reversed_z: bool,
+) -> (DVec4, DVec4) {
+    let (l, r, b, t) = (lo.x, hi.x, lo.y, hi.y);
+    let (n, f) = if reversed_z { (far, near) } else { (near, far) };
+    let rcp = 1.0 / (n - f);
+    let scale = DVec4::new(2.0 / (r - l), 2.0 / (t - b), rcp, 0.0);
+    let offset = DVec4::new(-(r + l) / (r - l), -(t + b) / (t - b), rcp * n, 1.0);
+    (scale, offset)
 }
 
 /// Off-centre perspective from the tangents of the side planes, between distances
@@ -120,8 +141,12 @@ pub fn perspective_infinite(fov_y: f64, aspect: f64, near: f64, reversed_z: bool
 /// parallel to `dir` (right-handed, the view looks down `-Z`).
 #[must_use]
 pub fn look_to(eye: DVec3, dir: DVec3, up: DVec3) -> DMat4 {
+    look_to_side(eye, dir, dir.cross(up).normalize())
+}
+
+/// [`look_to`] from its unit side axis `s = normalize(dir × up)`.
+fn look_to_side(eye: DVec3, dir: DVec3, s: DVec3) -> DMat4 {
     let f = dir;
-    let s = f.cross(up).normalize();
     let u = s.cross(f);
     DMat4::from_cols(
         DVec4::new(s.x, u.x, -f.x, 0.0),
@@ -155,9 +180,13 @@ pub fn light_rotation(dir: DVec3, up_hint: Vec3) -> DMat4 {
     } else {
         None
     };
-    let up = match up {
-        Some(u) if dir.cross(u).length() > 1e-3 => u,
-        _ => least_aligned_axis(dir),
-    };
-    look_to(DVec3::ZERO, dir, up)
+    if let Some(u) = up {
+        // `look_to`'s side axis is this cross product, normalized: computed once.
+        let side = dir.cross(u);
+        let length = side.length();
+        if length > 1e-3 {
+            return look_to_side(DVec3::ZERO, dir, side * (1.0 / length));
+        }
+    }
+    look_to(DVec3::ZERO, dir, least_aligned_axis(dir))
 }

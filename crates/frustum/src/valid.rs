@@ -101,7 +101,7 @@ impl ValidCamera {
     /// World space to view space, as [`Camera::view_from_world`].
     #[must_use]
     pub fn view_from_world(&self) -> Mat4 {
-        self.geometry.view_from_world().as_mat4()
+        self.geometry.view_from_world32
     }
 
     /// Camera position in world space.

@@ -10,6 +10,7 @@ use shadowmap_frustum::{
 
 use crate::ParaboloidError;
 use crate::cube_fit::{FaceExtent, effective_near, face_extent};
+use crate::cube_sizes::FaceSizes;
 use crate::map::check_depth_range;
 
 /// One face of a cube map: the direction it looks along, world axis aligned.
@@ -123,6 +124,12 @@ pub struct CubeOptions {
     pub focused: bool,
     /// Store depth as 1 at the near plane and 0 at the far plane. Default `false`.
     pub reversed_z: bool,
+    /// Texels over all kept faces (the whole atlas), at least 1. Default `1024²`.
+    /// `shadowmap::fit` sets it from its input's budget.
+    pub texel_budget: u64,
+    /// How the kept faces share the budget. Default [`FaceSizes::Equal`] (what a
+    /// texture array, and the `shadowmap-wgpu` pass, renders).
+    pub sizes: FaceSizes,
 }
 
 impl Default for CubeOptions {
@@ -131,6 +138,8 @@ impl Default for CubeOptions {
             near: 0.05,
             focused: true,
             reversed_z: false,
+            texel_budget: 1024 * 1024,
+            sizes: FaceSizes::Equal,
         }
     }
 }
@@ -154,11 +163,23 @@ impl CubeOptions {
         self.reversed_z = reversed_z;
         self
     }
+    /// With this many texels over all faces.
+    #[must_use]
+    pub const fn with_texel_budget(mut self, texels: u64) -> Self {
+        self.texel_budget = texels;
+        self
+    }
+    /// With this sharing of the budget.
+    #[must_use]
+    pub const fn with_sizes(mut self, sizes: FaceSizes) -> Self {
+        self.sizes = sizes;
+        self
+    }
 
     pub(crate) fn validate(&self) -> Result<(), ParaboloidError> {
         if !self.near.is_finite() {
             Err(ParaboloidError::NonFinite)
-        } else if self.near > 0.0 {
+        } else if self.near > 0.0 && self.texel_budget > 0 {
             Ok(())
         } else {
             Err(ParaboloidError::InvalidOptions)
@@ -188,6 +209,11 @@ pub struct CubeFace {
     pub near: f32,
     /// Distance along the face's axis mapped to depth 1 (0 with reversed-Z).
     pub far: f32,
+    /// Width and height in texels of the face's map (square unless a warp asked for
+    /// more texels along one axis, see [`CubeMap::set_sizes_by_need`]).
+    pub size: [u32; 2],
+    /// Texel offset of the face's map in the cube's atlas ([`CubeMap::atlas`]).
+    pub offset: [u32; 2],
 }
 
 impl CubeFace {
@@ -227,6 +253,8 @@ impl CubeFace {
             tan_max: hi.as_vec2(),
             near,
             far,
+            size: [0, 0],
+            offset: [0, 0],
         })
     }
 
@@ -270,10 +298,13 @@ impl CubeFace {
 pub struct CubeMap {
     /// Light position in world space.
     pub position: Vec3,
-    /// The kept faces; face `i` renders into layer `i`.
+    /// The kept faces; face `i` is layer `i` of [`ShadowMapping::map_point`]'s samples.
     pub faces: ArrayVec<CubeFace, 6>,
     /// Whether depth is reversed.
     pub reversed_z: bool,
+    /// Width and height in texels of the atlas holding every face's map (a column
+    /// of equal tiles with [`FaceSizes::Equal`]); its area is what the map costs.
+    pub atlas: [u32; 2],
 }
 
 /// Smallest extent of a window, in tangents: a window spans at least
@@ -347,11 +378,66 @@ impl CubeMap {
         if faces.is_empty() {
             return Err(FrustumError::SliceOutsideScene.into());
         }
-        Ok(Self {
+        let mut cube = Self {
             position,
             faces,
             reversed_z: options.reversed_z,
-        })
+            atlas: [0, 0],
+        };
+        cube.share_budget(camera, &scene.receivers, options);
+        Ok(cube)
+    }
+
+    /// Narrows the window of the face in `layer` to the part of it between texture
+    /// coordinates `uv_min` and `uv_max` (a rectangle of its current `uv`, `v` down;
+    /// clamped to `[0, 1]²`, at least `1e-3` wide in tangents), keeping its depth
+    /// range, size and place in the atlas: for a renderer that knows which part of a
+    /// face its visible samples use (sample distribution focusing). Nothing changes
+    /// for a layer past the last or an empty or non-finite rectangle.
+    ///
+    /// # Errors
+    /// [`ParaboloidError::NonFinite`] when the narrowed face's matrix is not finite
+    /// (the face is then unchanged).
+    pub fn narrow_to_uv(
+        &mut self,
+        layer: u32,
+        uv_min: DVec2,
+        uv_max: DVec2,
+    ) -> Result<(), ParaboloidError> {
+        let position = self.position.as_dvec3();
+        let reversed_z = self.reversed_z;
+        let Some(f) = self.faces.get_mut(layer as usize) else {
+            return Ok(());
+        };
+        let (lo, hi) = (
+            uv_min.clamp(DVec2::ZERO, DVec2::ONE),
+            uv_max.clamp(DVec2::ZERO, DVec2::ONE),
+        );
+        if !(lo.is_finite() && hi.is_finite() && lo.cmplt(hi).all()) {
+            return Ok(());
+        }
+        let (t_lo, t_hi) = (f.tan_min.as_dvec2(), f.tan_max.as_dvec2());
+        let at = |uv: DVec2| t_lo + DVec2::new(uv.x, 1.0 - uv.y) * (t_hi - t_lo);
+        let (a, b) = (at(lo), at(hi));
+        let (mut tan_min, mut tan_max) = (a.min(b), a.max(b));
+        let grow = (DVec2::splat(MIN_TAN_EXTENT) - (tan_max - tan_min)).max(DVec2::ZERO) * 0.5;
+        tan_min -= grow;
+        tan_max += grow;
+        let extent = FaceExtent {
+            tan_min,
+            tan_max,
+            receivers_min: f64::from(f.near),
+            receivers_max: f64::from(f.far),
+            near: f64::from(f.near),
+            far: f64::from(f.far),
+        };
+        let narrowed = CubeFace::new(f.face, position, &extent, reversed_z)?;
+        *f = CubeFace {
+            size: f.size,
+            offset: f.offset,
+            ..narrowed
+        };
+        Ok(())
     }
 
     /// Number of texture-array layers (kept faces), 1 to 6.
@@ -455,6 +541,8 @@ mod serde_impls {
         near: f32,
         focused: bool,
         reversed_z: bool,
+        texel_budget: u64,
+        sizes: crate::FaceSizes,
     }
 
     shadowmap_frustum::__deserialize_checked!(
@@ -548,6 +636,82 @@ mod tests {
         assert!(focused.faces.iter().any(|f| area(f) < 2.0));
     }
 
+    /// Equal sides make a column of layers; sides by need give the face toward the
+    /// eye's near ground (the light's `+Z` face, the camera being behind it along
+    /// `+Z`) the most texels; both stay within the budget, their tiles apart, and a
+    /// sample lands in its face's tile of the atlas.
+    #[test]
+    fn faces_share_the_budget() {
+        let (camera, light, scene) = street();
+        let budget = 512 * 512;
+        let equal = CubeOptions::default()
+            .with_texel_budget(budget)
+            .with_sizes(FaceSizes::Equal);
+        let cube = CubeMap::fit(&light, &camera, None, &scene, &equal).unwrap();
+        assert!(cube.has_equal_faces());
+        let [side, _] = cube.faces[0].size;
+        assert_eq!(cube.atlas, [side, side * cube.layers()]);
+        let by_need = equal.with_sizes(FaceSizes::ByNeed);
+        let cube = CubeMap::fit(&light, &camera, None, &scene, &by_need).unwrap();
+        assert!(!cube.has_equal_faces());
+        assert!(
+            cube.texels() <= budget && cube.texels() > budget / 2,
+            "{}",
+            cube.texels()
+        );
+        assert!(cube.faces.iter().all(|f| f.size[0] == f.size[1]));
+        let largest = cube.faces.iter().max_by_key(|f| f.size[0]).unwrap();
+        assert_eq!(largest.face, CubeFaceId::PosZ, "{:?}", cube.faces);
+        let p = DVec3::new(1.0, 0.5, -10.0);
+        let s = cube.map_point(p).unwrap();
+        let a = cube.atlas_sample(s).unwrap();
+        let f = &cube.faces[s.layer as usize];
+        let pair = |p: [u32; 2]| DVec2::new(f64::from(p[0]), f64::from(p[1]));
+        let texel = a.uv * pair(cube.atlas);
+        let lo = pair(f.offset);
+        assert!(texel.cmpge(lo).all() && texel.cmple(lo + pair(f.size)).all());
+        assert_eq!((a.layer, a.depth), (0, s.depth));
+    }
+
+    /// A face drawn into the corner of a layer of the largest face's side lands
+    /// where its own `uv`, scaled by its share of the layer, says: the corner
+    /// clip matrix and the scaled lookup agree, and the face keeps its texels.
+    #[test]
+    fn faces_drawn_into_layer_corners_keep_their_uv() {
+        let (camera, light, scene) = street();
+        let by_need = CubeOptions::default().with_sizes(FaceSizes::ByNeed);
+        let cube = CubeMap::fit(&light, &camera, None, &scene, &by_need).unwrap();
+        let side = cube.largest_side();
+        for f in &cube.faces {
+            let texels = f.uv_scale_in_layer(side).as_dvec2() * f64::from(side);
+            let size = DVec2::new(f64::from(f.size[0]), f64::from(f.size[1]));
+            assert!(
+                (texels - size).abs().max_element() < 1e-3,
+                "{texels} {size}"
+            );
+        }
+        let mut checked = 0;
+        for x in [-40.0, -5.0, 0.0, 7.0, 30.0] {
+            for z in [-200.0, -60.0, -31.0, -29.0, -10.0] {
+                let p = DVec3::new(x, 0.5, z);
+                let Some(s) = cube.map_point(p) else {
+                    continue;
+                };
+                let face = &cube.faces[s.layer as usize];
+                let c = face.clip_from_world_in_layer(side).as_dmat4() * p.extend(1.0);
+                let ndc = c.truncate() / c.w;
+                let uv = DVec2::new(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
+                let scaled = s.uv * face.uv_scale_in_layer(side).as_dvec2();
+                assert!(
+                    (uv - scaled).abs().max_element() < 1e-5,
+                    "{p}: {uv} {scaled}"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked >= 20, "{checked}");
+    }
+
     #[test]
     fn bad_input_is_a_typed_error() {
         let (camera, light, scene) = street();
@@ -567,11 +731,12 @@ mod tests {
             CubeMap::fit(&nan, &camera, None, &scene, &o),
             Err(ParaboloidError::NonFinite)
         );
-        let bad = o.with_near(0.0);
-        assert_eq!(
-            CubeMap::fit(&light, &camera, None, &scene, &bad),
-            Err(ParaboloidError::InvalidOptions)
-        );
+        for bad in [o.with_near(0.0), o.with_texel_budget(0)] {
+            assert_eq!(
+                CubeMap::fit(&light, &camera, None, &scene, &bad),
+                Err(ParaboloidError::InvalidOptions)
+            );
+        }
         let short = Light::Point {
             position: Vec3::new(0.0, 100.0, 300.0),
             range: 1.0,

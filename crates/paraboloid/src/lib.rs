@@ -20,7 +20,9 @@
 //!   ([`ConeFit`]);
 //! - [`fit_paper_cone`] and [`fit_minimal_cone`]: the two cone fits on their own;
 //! - [`edge_subdivisions`], [`subdivide_triangle`], [`subdivide_triangles`]: caster
-//!   subdivision, because wgpu has no tessellation stage;
+//!   subdivision, because wgpu has no tessellation stage (its rule,
+//!   [`SubdivisionOptions::split_rule`], is shared with the GPU refinement of
+//!   `shadowmap-wgpu`);
 //! - [`CubeMap`]: cube shadow maps, what engines ship for point lights and the
 //!   baseline the paraboloid maps are measured against: the faces that see visible
 //!   receivers, each focused on them (see [Cube maps](#cube-maps)).
@@ -133,6 +135,18 @@
 //! same report the dual fallback then beats the downward DPSM on every point
 //! configuration instead of losing (`facing_point` 15.5, `point_inside` 4.56).
 //!
+//! The same cost also decides a cone under 90 degrees: a wide cut spends the single
+//! map's texels at its sparse centre (a texel there spans `zoom (1 + cos theta)`
+//! times a dual map's centre texel), while the dual map has `1 / sqrt 2` of its
+//! side, so the plan goes dual ([`DualReason::DualFiner`]) when
+//!
+//! ```text
+//! max_i zoom (|v_i| + a . v_i) / s_i / sqrt(2)  >  cost(dual axis)
+//! ```
+//!
+//! ([`IpsmPlan::with_dual`] builds a plan's dual alternatives for a renderer that
+//! measures them on its own samples, as `shadowmap::fit` does with eye samples.)
+//!
 //! # Measured gain
 //!
 //! Over 2000 random light and camera configurations (`examples/ipsm_table.rs`; the
@@ -201,7 +215,7 @@
 //! # Cube maps
 //!
 //! [`CubeMap::fit`] renders up to six 90-degree perspective faces around the light
-//! (world-axis aligned, [`CubeFaceId`]), one texture-array layer per kept face, with
+//! (world-axis aligned, [`CubeFaceId`]), one map per kept face, with
 //! ordinary matrices (`clip_from_world`, WebGPU clip space, reversed-Z optional), so
 //! no caster subdivision is needed. As IPSM focuses the paraboloid, it focuses each
 //! face on the visible receivers `V = slice ∩ receivers ∩ range box` (the truncated
@@ -216,9 +230,21 @@
 //!
 //! A face whose window is empty is skipped. [`CubeOptions::focused`] off keeps the
 //! same faces at their full 90 degrees over `[near, range]`: the unfocused cube of
-//! the engines that skip faces by culling. The layers share the texel budget
-//! equally (equal sides), so a face skipped gives the others more texels, and a
-//! focused window never has fewer texels per steradian than the full face.
+//! the engines that skip faces by culling.
+//!
+//! The faces share [`CubeOptions::texel_budget`] ([`CubeOptions::sizes`]):
+//! [`FaceSizes::Equal`] gives each the same side (one texture-array layer each, what
+//! engines and the `shadowmap-wgpu` pass render), so a face skipped gives the others
+//! more texels and a focused window never has fewer texels per steradian than the
+//! full face. With the light among the visible receivers every face is kept, and the
+//! faces toward the eye need several times the texels of the others:
+//! [`FaceSizes::ByNeed`] sizes each face by the density it needs (predicted on the
+//! receivers' box; `shadowmap::fit` measures it on the eye's samples when it has
+//! them, see [`CubeMap::set_sizes_by_need`]), so every face is predicted to reach the
+//! same error. The faces' maps are then tiles of one atlas ([`CubeMap::atlas`],
+//! shelves of tiles, the largest first), and its whole area is what the map costs
+//! ([`CubeMap::texels`]); [`CubeMap::atlas_sample`] turns a face's sample into atlas
+//! coordinates.
 //!
 //! A point maps through the kept face whose window holds it, the major-axis face
 //! first (see [`CubeFace::sample`] for the formula); the depth is the perspective
@@ -256,27 +282,32 @@
 //! ```
 //!
 //! Measured with the `compare` report of `shadowmap-eval` (seed 1, 1M texels, p95
-//! aliasing error `m`; the same figures within 4% on seeds 2 and 3):
+//! aliasing error `m`; `cube`: focused, sized by the eye samples' needs; `equal`:
+//! equal full faces, what engines render; RTW over the focused faces is the
+//! umbrella's `CubeRtw`):
 //!
-//! | configuration | DPSM | IPSM exact | cube, focused | cube, full faces |
-//! |---|---|---|---|---|
-//! | `point_near` | 4.73 | 2.62 | 2.46 (5 faces) | 2.46 |
-//! | `point_mid` | 28.9 | 13.2 | 13.3 (5 faces) | 18.6 |
-//! | `point_far` | 115 | 55.7 | 54.5 (5 faces) | 97.2 |
-//! | `point_inside` | 5.02 | 4.56 | 5.42 (6 faces) | 5.42 |
-//! | `facing_point` | 18.4 | 15.5 | 23.7 (6 faces) | 23.7 |
+//! | configuration | DPSM | IPSM exact | cube, by need | cube, equal full faces | RTW over the faces |
+//! |---|---|---|---|---|---|
+//! | `point_near` | 4.73 | 2.62 | 1.90 (5 faces) | 2.46 | 1.19 |
+//! | `point_mid` | 28.9 | 13.2 | 7.48 (5 faces) | 18.6 | 1.69 |
+//! | `point_far` | 115 | 55.7 | 27.2 (5 faces) | 97.2 | 2.68 |
+//! | `point_inside` | 5.02 | 4.56 | 5.04 (6 faces) | 5.42 | 1.06 |
+//! | `facing_point` | 18.4 | 15.5 | 11.9 (6 faces) | 23.7 | 1.91 |
 //!
-//! With the light among the visible receivers every face is kept at full size, and
-//! six maps of `1024² / 6` texels lose to a DPSM's two of `1024² / 2` (1.08 and 1.29
-//! times its `m`); once faces can be skipped and focused, the cube halves the DPSM's
-//! error. The fit costs about 0.1 ms (`cargo bench --bench paraboloid -- cube_fit`:
-//! focused about 8 times an exact IPSM plan on the shared development machine).
+//! With the light among the visible receivers every face is kept, and six equal maps
+//! of `1024² / 6` texels lose to a DPSM's two of `1024² / 2` (1.08 and 1.29 times its
+//! `m`); sized by need, the faces toward the eye get the texels and the cube halves
+//! the DPSM's error or better. The focused fit costs about 0.1 ms with equal faces
+//! (`cargo bench --bench paraboloid -- cube_fit`: about 8 times an exact IPSM plan on
+//! the shared development machine); sizing by the prediction on the receivers' box
+//! casts a grid of 24 x 14 view rays on top.
 //!
 //! Errors ([`ParaboloidError`]): as the other builders for non-finite input, a bad
 //! near option or depth range, and a directional light;
 //! `ParaboloidError::Frustum(FrustumError::SliceOutsideScene)` when no visible
-//! receiver is within the light's range (nothing to shadow). The fit allocates
-//! nothing (fixed arrays of six faces; the projected points of a face on the stack).
+//! receiver is within the light's range (nothing to shadow); a zero texel budget is
+//! `InvalidOptions`. The fit allocates nothing (fixed arrays of six faces; the
+//! projected points of a face and the prediction's rays on the stack).
 //!
 //! # Features
 //!
@@ -297,6 +328,7 @@ extern crate alloc;
 mod cone;
 mod cube;
 mod cube_fit;
+mod cube_sizes;
 mod error;
 mod map;
 mod orient;
@@ -307,11 +339,13 @@ mod subdivide;
 
 pub use cone::{Cone, ConeFit, MAX_CONE_DIRECTIONS, MIN_ZOOM, fit_minimal_cone, fit_paper_cone};
 pub use cube::{CubeFace, CubeFaceId, CubeMap, CubeOptions};
+pub use cube_sizes::{FaceSizes, MIN_ASPECT, MIN_SIDE_RATIO};
 pub use error::ParaboloidError;
 pub use map::{MapOptions, ParaboloidMap, ParaboloidMode, ParaboloidUniform, Side, UsableDisc};
 pub use plan::{DualReason, IpsmOptions, IpsmPlan};
 pub use subdivide::{
-    SubdivisionOptions, edge_subdivisions, subdivide_triangle, subdivide_triangles,
+    DEVIATION_SAMPLES, ParaboloidSplitRule, SubdivisionOptions, edge_subdivisions,
+    subdivide_triangle, subdivide_triangles,
 };
 
 pub use shadowmap_frustum;

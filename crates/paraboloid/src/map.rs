@@ -338,6 +338,37 @@ impl ParaboloidMap {
         self.sample_on(self.to_light(world.as_dvec3()), side)
     }
 
+    /// The depth pass's user clip distance of `world` on `side`: the cosine of its
+    /// angle from the side's plane through the light, positive in front of the side
+    /// (toward its axis), negative behind it, 0 at the light.
+    ///
+    /// ```text
+    /// q = light_from_world * (P - position)
+    /// front: -q.z / |q|      back: q.z / |q|
+    /// ```
+    #[must_use]
+    pub fn clip_distance(&self, world: Vec3, side: Side) -> f64 {
+        let len = self.to_light(world.as_dvec3()).length();
+        if !(len > 0.0 && len.is_finite()) {
+            return 0.0;
+        }
+        self.plane_distance(world, side) / len
+    }
+
+    /// The signed distance of `world` to the side's plane through the light (`-q.z`
+    /// on the front side, `q.z` on the back), an affine function of the point with
+    /// the sign of [`clip_distance`](Self::clip_distance): a triangle whose three
+    /// vertices lie behind the side lies behind it whole, and one across the plane
+    /// is cut where this is 0.
+    #[must_use]
+    pub fn plane_distance(&self, world: Vec3, side: Side) -> f64 {
+        let z = self.to_light(world.as_dvec3()).z;
+        match side {
+            Side::Front => -z,
+            Side::Back => z,
+        }
+    }
+
     /// The shadow lookup, mirrored by the shader: picks the side with
     /// [`ParaboloidMap::side_of`], then projects. `None` at the light, and for a
     /// single map where `uv` falls outside `[0, 1]²` (outside the cut).
@@ -522,6 +553,28 @@ mod tests {
         let b = m.project(Vec3::new(-9.0, 2.0, 3.0), Side::Back).unwrap();
         assert!((b.uv - DVec2::splat(0.5)).length() < 1e-6);
         assert_eq!(m.side_of(Vec3::new(-9.0, 2.0, 3.0)), Side::Back);
+    }
+
+    /// The clip distance is the cosine from the side's plane: 1 on the axis, 0 on the
+    /// rim, the opposite sign on the other side, and it keeps what the side stores.
+    #[test]
+    fn clip_distance_is_the_cosine_from_the_plane() {
+        let m = map();
+        let on_axis = Vec3::new(11.0, 2.0, 3.0);
+        assert!((m.clip_distance(on_axis, Side::Front) - 1.0).abs() < 1e-6);
+        assert!((m.clip_distance(on_axis, Side::Back) + 1.0).abs() < 1e-6);
+        assert!(
+            m.clip_distance(Vec3::new(1.0, 12.0, 3.0), Side::Front)
+                .abs()
+                < 1e-6
+        );
+        let p = Vec3::new(4.0, -1.0, 7.0);
+        let c = m.clip_distance(p, Side::Front);
+        assert!((c - 3.0 / 34.0_f64.sqrt()).abs() < 1e-6, "{c}");
+        assert_eq!(m.side_of(p), Side::Front);
+        assert_eq!(m.clip_distance(m.position, Side::Front), 0.0);
+        assert!((m.plane_distance(p, Side::Front) - 3.0).abs() < 1e-6);
+        assert!((m.plane_distance(p, Side::Back) + 3.0).abs() < 1e-6);
     }
 
     #[test]

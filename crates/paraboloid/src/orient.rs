@@ -26,6 +26,8 @@ use arrayvec::ArrayVec;
 use glam::DVec3;
 use shadowmap_frustum::math;
 
+use crate::cone::{DCone, zoom_for_half_angle};
+
 /// Number of sample points: 3 cross-sections of 4 corners and a centre.
 const SAMPLES: usize = 15;
 
@@ -131,6 +133,38 @@ pub(crate) fn dual_axis(
         s < 0.0
     };
     if flip { -best } else { best }
+}
+
+/// Side of one paraboloid over the side of each of a dual map's two at the same
+/// texel budget (`k` layers of side `sqrt(budget / k)`).
+const SINGLE_SIDE_GAIN: f64 = core::f64::consts::SQRT_2;
+
+/// Whether one cut paraboloid (front axis the cone's, cut to the cone widened by
+/// `margin`: `zoom = tan((half_angle + margin) / 2)`) is predicted to
+/// sample the truncated frustum `pts` at least as finely as the dual map with front
+/// axis `dual`, at the same texel budget. A cut map's texel at angle `theta` from its
+/// axis spans `zoom (1 + cos theta)` times what a dual map's spans at its centre, and
+/// it has [`SINGLE_SIDE_GAIN`] times the texels per side:
+///
+/// ```text
+/// single: max_i zoom (|v_i| + a . v_i) / s_i / sqrt(2)
+/// dual:   max_i (|v_i| + |a' . v_i|) / s_i          (the cost of `dual_axis`)
+/// ```
+pub(crate) fn single_is_finer(
+    l: DVec3,
+    pts: &[DVec3; 8],
+    cone: DCone,
+    margin: f64,
+    dual: DVec3,
+) -> bool {
+    let (axis, zoom) = (cone.axis, zoom_for_half_angle(cone.half_angle + margin));
+    let samples = samples(l, pts);
+    let single = samples
+        .iter()
+        .map(|s| zoom * (s.length + axis.dot(s.v)) * s.inv_size)
+        .fold(0.0, f64::max)
+        / SINGLE_SIDE_GAIN;
+    !(single > cost_below(dual, &samples, f64::INFINITY))
 }
 
 #[cfg(test)]

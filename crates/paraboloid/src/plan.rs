@@ -8,7 +8,7 @@ use crate::cone::{
     Cone, ConeFit, DCone, MIN_ZOOM, minimal_fit, paper_fit, round_up_f32, zoom_for_half_angle,
 };
 use crate::map::{MapOptions, ParaboloidMap, ParaboloidMode, Side, check_depth_range};
-use crate::orient::dual_axis;
+use crate::orient::{dual_axis, single_is_finer};
 
 /// Knobs of [`IpsmPlan`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -114,6 +114,10 @@ pub enum DualReason {
     /// The fitted cone (margin included) is wider than
     /// [`IpsmOptions::max_single_half_angle`].
     ConeTooWide,
+    /// The cone fits one paraboloid, but a wide cut spends the single map's texels
+    /// at its sparse centre: the dual map (each side half the texels, its seam
+    /// through the view) is predicted to sample the truncated frustum more finely.
+    DualFiner,
 }
 
 /// An improved paraboloid shadow map plan (Vanek et al.): the paper's four steps.
@@ -279,8 +283,12 @@ impl IpsmPlan {
                 }
             }
         };
+        let dual = || dual_axis(l, &pts, up_hint, fallback_axis, fallback_axis);
         let reason = match (reason, cone) {
             (None, Some(c)) if c.half_angle + margin >= max_single => Some(DualReason::ConeTooWide),
+            (None, Some(c)) if !single_is_finer(l, &pts, c, margin, dual()) => {
+                Some(DualReason::DualFiner)
+            }
             (r, _) => r,
         };
         let map = match (reason, cone) {
@@ -295,7 +303,7 @@ impl IpsmPlan {
             )?,
             _ => ParaboloidMap::build(
                 light_position,
-                dual_axis(l, &pts, up_hint, fallback_axis, fallback_axis).as_vec3(),
+                dual().as_vec3(),
                 options.near,
                 range,
                 1.0,
@@ -335,6 +343,54 @@ impl IpsmPlan {
     #[must_use]
     pub fn zoom(&self) -> f32 {
         self.map.zoom
+    }
+
+    /// This plan with a dual map: front axis `axis` (world, any length), or the
+    /// plan's own dual axis (the seam through the view, see [`IpsmPlan::new`]) when
+    /// `None`; the light, depth range, cone and border points kept. For a renderer
+    /// that measures the candidates on its own samples (a dual map of this plan's
+    /// axis, or of a DPSM's fixed axis). A single plan becomes dual with
+    /// [`DualReason::DualFiner`].
+    ///
+    /// # Errors
+    /// As [`IpsmPlan::new`] for bad `options`; [`ParaboloidError::ZeroDirection`] /
+    /// [`ParaboloidError::NonFinite`] for a bad `axis`.
+    pub fn with_dual(
+        &self,
+        axis: Option<Vec3>,
+        options: &IpsmOptions,
+    ) -> Result<Self, ParaboloidError> {
+        options.validate()?;
+        let l = self.map.position.as_dvec3();
+        let pts = self.border_points.map(Vec3::as_dvec3);
+        let up_hint = options
+            .up_hint
+            .as_dvec3()
+            .try_normalize()
+            .unwrap_or(DVec3::ZERO);
+        let axis = match axis {
+            Some(a) => a,
+            None => {
+                let centroid = pts.iter().copied().sum::<DVec3>() / 8.0;
+                let fallback = (centroid - l).try_normalize().unwrap_or(DVec3::NEG_Z);
+                dual_axis(l, &pts, up_hint, fallback, fallback).as_vec3()
+            }
+        };
+        let map_options = MapOptions::default()
+            .with_up_hint(options.up_hint)
+            .with_reversed_z(options.reversed_z);
+        let map = ParaboloidMap::dual(
+            self.map.position,
+            axis,
+            self.map.near,
+            self.map.far,
+            &map_options,
+        )?;
+        Ok(Self {
+            map,
+            dual_reason: self.dual_reason.or(Some(DualReason::DualFiner)),
+            ..*self
+        })
     }
 }
 

@@ -1,5 +1,8 @@
-//! Caster subdivision: wgpu has no tessellation stage, so edges are split on the CPU
-//! until their linearly rasterized image stays near the true paraboloid curve.
+//! Caster subdivision: wgpu has no tessellation stage, so edges are split until their
+//! linearly rasterized image stays near the true paraboloid curve. This is the
+//! reference; the compute refinement of `shadowmap-wgpu` is its twin on the GPU (the
+//! same rule, [`SubdivisionOptions::split_rule`] and [`DEVIATION_SAMPLES`], and the
+//! same pieces, evaluated in `f32`).
 
 use glam::{DVec2, DVec3, Vec3};
 
@@ -67,6 +70,54 @@ impl SubdivisionOptions {
     }
 }
 
+/// Fractions of a segment at which [`edge_subdivisions`] measures the distance of the
+/// image curve from the segment's straight raster (its chord).
+pub const DEVIATION_SAMPLES: [f64; 3] = [0.25, 0.5, 0.75];
+
+/// The numbers the edge rule of [`edge_subdivisions`] runs on, checked: what a GPU
+/// twin of the subdivision (the compute refinement of `shadowmap-wgpu`) needs to
+/// decide as the CPU does.
+///
+/// ```text
+/// c(t) = resolution * uv(a + t (b - a))
+/// n = 1
+/// loop:
+///     dev = max over k < n, f in DEVIATION_SAMPLES of dist(c((k + f) / n), chord k)
+///           (max_segments where c is undefined: through the light or the pole)
+///     if dev <= tolerance_texels or n >= max_segments: return min(n, max_segments)
+///     n = min(max(floor(n sqrt(dev / tolerance_texels)), n + 1), max_segments)
+/// triangle: n = max over its edges; the n² pieces of the barycentric grid
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParaboloidSplitRule {
+    /// Texels per side of the map: `c(t)` is in texels.
+    pub resolution: f64,
+    /// The deviation bound, in texels.
+    pub tolerance_texels: f64,
+    /// Most segments per edge.
+    pub max_segments: u32,
+    /// `ceil(log2(max_segments))`, in `0..=8`: a triangle is cut into at most
+    /// `2^levels` segments per edge.
+    pub levels: u32,
+}
+
+impl SubdivisionOptions {
+    /// The checked split rule of these options.
+    ///
+    /// # Errors
+    /// [`ParaboloidError::NonFinite`] for a non-finite tolerance;
+    /// [`ParaboloidError::InvalidSubdivision`] for options out of range.
+    pub fn split_rule(&self) -> Result<ParaboloidSplitRule, ParaboloidError> {
+        self.validate()?;
+        Ok(ParaboloidSplitRule {
+            resolution: f64::from(self.resolution),
+            tolerance_texels: f64::from(self.tolerance_texels),
+            max_segments: self.max_segments,
+            levels: self.max_segments.next_power_of_two().trailing_zeros(),
+        })
+    }
+}
+
 /// Texel-space image of a light-space point on `side`.
 fn texel(map: &ParaboloidMap, side: Side, q: DVec3, resolution: f64) -> Option<DVec2> {
     let p = ParaboloidMap::disc_point(q, side)?;
@@ -94,7 +145,7 @@ fn deviation(map: &ParaboloidMap, side: Side, a: DVec3, b: DVec3, n: u32, res: f
     for k in 0..n {
         let t0 = f64::from(k) * step;
         let next = at(t0 + step)?;
-        for f in [0.25, 0.5, 0.75] {
+        for f in DEVIATION_SAMPLES {
             let m = at(t0 + f * step)?;
             worst = worst.max(segment_distance(m, prev, next));
         }
@@ -103,9 +154,8 @@ fn deviation(map: &ParaboloidMap, side: Side, a: DVec3, b: DVec3, n: u32, res: f
     worst.is_finite().then_some(worst)
 }
 
-fn edge_count(map: &ParaboloidMap, side: Side, a: DVec3, b: DVec3, o: &SubdivisionOptions) -> u32 {
-    let res = f64::from(o.resolution);
-    let tol = f64::from(o.tolerance_texels);
+fn edge_count(map: &ParaboloidMap, side: Side, a: DVec3, b: DVec3, o: &ParaboloidSplitRule) -> u32 {
+    let (res, tol) = (o.resolution, o.tolerance_texels);
     let mut n = 1u32;
     loop {
         let Some(dev) = deviation(map, side, a, b, n, res) else {
@@ -149,12 +199,12 @@ pub fn edge_subdivisions(
     b: Vec3,
     options: &SubdivisionOptions,
 ) -> Result<u32, ParaboloidError> {
-    options.validate()?;
+    let rule = options.split_rule()?;
     if !(a.is_finite() && b.is_finite()) {
         return Err(ParaboloidError::NonFinite);
     }
     let (qa, qb) = (map.to_light(a.as_dvec3()), map.to_light(b.as_dvec3()));
-    Ok(edge_count(map, side, qa, qb, options))
+    Ok(edge_count(map, side, qa, qb, &rule))
 }
 
 /// Splits a world triangle for rendering into paraboloid `side`: with `n` the largest
@@ -174,7 +224,7 @@ pub fn subdivide_triangle(
     options: &SubdivisionOptions,
     mut emit: impl FnMut([Vec3; 3]),
 ) -> Result<u32, ParaboloidError> {
-    options.validate()?;
+    let rule = options.split_rule()?;
     if !triangle.iter().all(|p| p.is_finite()) {
         return Err(ParaboloidError::NonFinite);
     }
@@ -182,7 +232,7 @@ pub fn subdivide_triangle(
     let q = triangle.map(|p| map.to_light(p.as_dvec3()));
     let n = [(0, 1), (1, 2), (2, 0)]
         .into_iter()
-        .map(|(i, j)| edge_count(map, side, q[i], q[j], options))
+        .map(|(i, j)| edge_count(map, side, q[i], q[j], &rule))
         .max()
         .unwrap_or(1);
     let nf = f64::from(n);
@@ -276,6 +326,20 @@ mod tests {
         let area = |t: &[Vec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]);
         let total: Vec3 = out.iter().map(area).sum();
         assert!((total - area(&tri)).length() < 1e-3 * area(&tri).length());
+    }
+
+    #[test]
+    fn split_rule_levels_cover_max_segments() {
+        for (max_segments, levels) in [(1, 0), (2, 1), (16, 4), (17, 5), (256, 8)] {
+            let rule = SubdivisionOptions::default()
+                .with_max_segments(max_segments)
+                .split_rule()
+                .unwrap();
+            assert_eq!(rule.levels, levels, "{max_segments}");
+            assert!(1u32 << rule.levels >= max_segments);
+        }
+        let bad = SubdivisionOptions::default().with_tolerance_texels(0.0);
+        assert_eq!(bad.split_rule(), Err(ParaboloidError::InvalidSubdivision));
     }
 
     #[test]

@@ -35,14 +35,7 @@ fn the_generator_reaches_the_interesting_cases() {
     let (mut fitted, mut inside_caster, mut all_six, mut fewer) = (0, 0, 0, 0);
     let mut state = 0x2545_f491_4f6c_dd1d_u64;
     for _ in 0..400 {
-        let bytes: Vec<u8> = (0..256)
-            .map(|_| {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                (state >> 24) as u8
-            })
-            .collect();
+        let bytes = shadowmap_testgen::xorshift_bytes(&mut state, 256);
         let Ok(input) = cube_input(&mut Unstructured::new(&bytes)) else {
             continue;
         };

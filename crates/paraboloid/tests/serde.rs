@@ -5,8 +5,8 @@
 
 use proptest::prelude::*;
 use shadowmap_paraboloid::{
-    ConeFit, DualReason, IpsmOptions, IpsmPlan, MapOptions, ParaboloidError, ParaboloidMode, Side,
-    SubdivisionOptions, fit_minimal_cone, fit_paper_cone,
+    ConeFit, DualReason, FaceSizes, IpsmOptions, IpsmPlan, MapOptions, ParaboloidError,
+    ParaboloidMode, Side, SubdivisionOptions, fit_minimal_cone, fit_paper_cone,
 };
 use shadowmap_testgen::serde_check::{rejects, rejects_with, round_trip};
 use shadowmap_testgen::{paraboloid as cases, strategy};
@@ -74,8 +74,12 @@ fn enums_round_trip() {
         DualReason::LightOnFrustumPoint,
         DualReason::DirectionsCancel,
         DualReason::ConeTooWide,
+        DualReason::DualFiner,
     ] {
         round_trip(&reason);
+    }
+    for sizes in [FaceSizes::Equal, FaceSizes::ByNeed] {
+        round_trip(&sizes);
     }
 }
 

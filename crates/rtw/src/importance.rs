@@ -581,65 +581,31 @@ impl ImportanceMap {
         pixels_per_radian: f32,
         samples: &[EyeSample],
     ) -> Result<AccumulateStats, RtwError> {
-        if !(pixels_per_radian.is_finite() && pixels_per_radian > 0.0) {
-            return Err(RtwError::InvalidOption);
-        }
-        camera.validate()?;
-        let base = Base::new(base)?;
-        check_samples(samples)?;
-        let eye = camera.eye().as_dvec3();
-        let forward = camera.forward().as_dvec3();
-        let right = camera
-            .world_from_view
-            .x_axis
-            .truncate()
-            .as_dvec3()
-            .normalize_or_zero();
-        let up = camera
-            .world_from_view
-            .y_axis
-            .truncate()
-            .as_dvec3()
-            .normalize_or_zero();
-        let f_px = f64::from(pixels_per_radian);
         let mut stats = AccumulateStats::default();
-        for s in samples {
-            let p = s.position.as_dvec3();
-            let value = (|| {
-                let (uv, h) = base.project(p)?;
-                let ray = (p - eye).normalize_or_zero();
-                let z = (p - eye).dot(forward);
-                if ray == DVec3::ZERO || z.is_nan() || z <= 0.0 {
-                    return None;
-                }
-                let mut n = s.normal.as_dvec3().normalize_or_zero();
-                if n == DVec3::ZERO {
-                    n = (base.toward_light(p) - ray).normalize_or_zero();
-                }
-                let nr = n.dot(ray);
-                if n == DVec3::ZERO || nr.abs() < 1e-6 {
-                    return None;
-                }
-                // One pixel step at view depth z, carried along the ray onto the plane.
-                let on_plane = |d: DVec3| d - ray * (n.dot(d) / nr);
-                let (dx, dy) = (on_plane(right * (z / f_px)), on_plane(up * (z / f_px)));
-                let (ju, jv) = base.jacobian(h);
-                let (a, b, c, d) = (ju.dot(dx), ju.dot(dy), jv.dot(dx), jv.dot(dy));
-                let q = match axis {
-                    OracleAxis::Isotropic => 1.0 / singular_min(a, b, c, d)?,
-                    // J⁻¹ = [[d, -b], [-c, a]] / det: its columns are the pixel
-                    // extents of a unit step in u and in v.
-                    OracleAxis::U => math::sqrt(d * d + c * c) / (a * d - b * c).abs(),
-                    OracleAxis::V => math::sqrt(b * b + a * a) / (a * d - b * c).abs(),
-                };
-                (q.is_finite() && q > 0.0).then_some((uv, q))
-            })();
-            match value {
-                Some((uv, q)) if self.splat_f64(uv, q) => stats.accepted += 1,
-                _ => stats.skipped += 1,
+        let skipped = oracle::oracle_needs(base, camera, pixels_per_radian, samples, |_, need| {
+            let q = match axis {
+                OracleAxis::Isotropic => need.isotropic,
+                OracleAxis::U => need.u,
+                OracleAxis::V => need.v,
+            };
+            if self.splat_f64(need.uv, q) {
+                stats.accepted += 1;
+            } else {
+                stats.skipped += 1;
             }
-        }
+        })?;
+        stats.skipped += skipped;
         Ok(stats)
+    }
+
+    /// Raises the cell holding base coordinates `uv` to at least `importance` (a
+    /// finite, non-negative value; others are ignored). Returns whether `uv` was
+    /// inside `[0, 1)²` and the value was written.
+    pub fn splat_need(&mut self, uv: DVec2, importance: f64) -> bool {
+        uv.is_finite()
+            && importance.is_finite()
+            && importance >= 0.0
+            && self.splat_f64(uv, importance)
     }
 }
 
@@ -653,19 +619,6 @@ pub enum OracleAxis {
     U,
     /// The density the `v` axis needs.
     V,
-}
-
-/// Smaller singular value of `[[a, b], [c, d]]`, `None` if not positive.
-fn singular_min(a: f64, b: f64, c: f64, d: f64) -> Option<f64> {
-    let (p, q, r) = (a * a + c * c, a * b + c * d, b * b + d * d);
-    let mean = 0.5 * (p + r);
-    let disc = math::sqrt((0.25 * (p - r) * (p - r) + q * q).max(0.0));
-    // l_min = det^2 / l_max is more accurate than mean - disc.
-    let l_max = mean + disc;
-    let det = a * d - b * c;
-    let l_min = det * det / l_max;
-    let s = math::sqrt(l_min);
-    (s.is_finite() && s > 0.0).then_some(s)
 }
 
 fn check_size(width: u32, height: u32) -> Result<usize, RtwError> {
@@ -699,5 +652,8 @@ fn check_samples(samples: &[EyeSample]) -> Result<(), RtwError> {
     if ok { Ok(()) } else { Err(RtwError::NonFinite) }
 }
 
+mod oracle;
 #[cfg(test)]
 mod tests;
+
+pub use oracle::{AxisNeed, PixelSteps, oracle_needs};

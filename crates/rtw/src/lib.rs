@@ -147,10 +147,13 @@ mod warp;
 
 pub use error::RtwError;
 pub use importance::{
-    AccumulateStats, BasePoint, EyeSample, ImportanceMap, ImportanceOptions, MAX_MAP_CELLS,
-    MAX_MAP_SIDE, OracleAxis,
+    AccumulateStats, AxisNeed, BasePoint, EyeSample, ImportanceMap, ImportanceOptions,
+    MAX_MAP_CELLS, MAX_MAP_SIDE, OracleAxis, PixelSteps, oracle_needs,
 };
-pub use subdivide::{RtwSplitRule, RtwSubdivision, subdivide_for_rtw, subdivide_for_rtw_with};
+pub use subdivide::{
+    ClipPlane, MAX_CLIP_PLANES, RtwSplitRule, RtwSubdivision, subdivide_for_rtw,
+    subdivide_for_rtw_clipped, subdivide_for_rtw_with,
+};
 pub use table::{
     forward_warp, forward_warp_f64, inverse_warp, inverse_warp_f64, sample_table, sample_table_f64,
 };

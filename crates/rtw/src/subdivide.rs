@@ -14,6 +14,7 @@
 
 use alloc::vec::Vec;
 
+use arrayvec::ArrayVec;
 use glam::{DVec2, Vec3};
 
 use crate::{RtwShadow, WarpMaps, forward_warp_f64};
@@ -78,6 +79,32 @@ impl RtwSubdivision {
     #[must_use]
     pub const fn with_max_segments(mut self, max_segments: u32) -> Self {
         self.max_segments = max_segments;
+        self
+    }
+
+    /// With the cap on pieces per edge that lets an edge spanning `extent` units of
+    /// base texture space (per axis) reach the span bound over tables of `cells`
+    /// texels: `ceil(extent * cells / max_span_cells)` pieces, at least the
+    /// current cap, at most 1024.
+    ///
+    /// The default cap suits a base whose visible part fits the map (an orthographic
+    /// or spot fit). A base whose casters span more of it, such as a paraboloid side
+    /// whose front hemisphere fills a disc of diameter `1 / zoom`, needs more: with
+    /// the default, a ground tile under a point light stays in pieces many cells
+    /// long whose straight warped images miss the warp by texels, and the surface
+    /// shadows itself.
+    #[must_use]
+    pub fn with_segments_for_extent(mut self, extent: f64, cells: usize) -> Self {
+        let defaults = Self::default();
+        let span = if self.max_span_cells.is_nan() {
+            defaults.max_span_cells
+        } else {
+            self.max_span_cells.max(1.0 / 64.0)
+        };
+        let need = shadowmap_frustum::math::ceil(extent * cells as f64 / span);
+        if need.is_finite() && need > f64::from(self.max_segments) {
+            self.max_segments = need.min(1024.0) as u32;
+        }
         self
     }
 }
@@ -145,7 +172,9 @@ impl RtwSubdivision {
 /// 4 (the midpoint triangle), each recursed into.
 ///
 /// Triangles with a vertex the base projection cannot map (behind a perspective
-/// light) or with non-finite vertices are passed through unsplit.
+/// light) or with non-finite vertices are dropped: a depth pass that warps vertices
+/// cannot place them (a perspective base wraps them around), and the reference
+/// rasterizer of `shadowmap-eval` drops them too.
 pub fn subdivide_for_rtw(
     shadow: &RtwShadow<'_>,
     triangles: &[[Vec3; 3]],
@@ -168,6 +197,38 @@ pub fn subdivide_for_rtw_with(
     options: &RtwSubdivision,
     out: &mut Vec<[Vec3; 3]>,
 ) -> usize {
+    subdivide_for_rtw_clipped(base_uv, &[], warps, triangles, options, out)
+}
+
+/// Most clip planes of [`subdivide_for_rtw_clipped`].
+pub const MAX_CLIP_PLANES: usize = 6;
+
+/// A clip plane of [`subdivide_for_rtw_clipped`]: the signed distance of a world
+/// point to the plane (any positive scale), an affine function of the point,
+/// negative on the side that is clipped.
+pub type ClipPlane<'a> = &'a dyn Fn(Vec3) -> f64;
+
+/// [`subdivide_for_rtw_with`] for a base that stores only the region in front of some
+/// planes (a paraboloid side: in front of the light's plane; a perspective face:
+/// inside its window's frustum). `planes` (the first [`MAX_CLIP_PLANES`]) bound that
+/// region ([`ClipPlane`]).
+///
+/// Triangles wholly behind a plane are left out; triangles across one are cut at it
+/// first (their part in front, one or two triangles per plane), then split. Behind
+/// a paraboloid side the base coordinates run off toward the pole, behind a
+/// perspective base they do not exist, and beside a perspective window they only
+/// cost pieces the depth pass clips: the split rule would spend levels of every edge
+/// on geometry the depth pass discards, or leave a caster unsplit. An edge is cut at
+/// the point interpolated from its end in front, so two triangles sharing it cut it
+/// alike (no cracks).
+pub fn subdivide_for_rtw_clipped(
+    base_uv: impl Fn(Vec3) -> Option<DVec2>,
+    planes: &[ClipPlane<'_>],
+    warps: &WarpMaps,
+    triangles: &[[Vec3; 3]],
+    options: &RtwSubdivision,
+    out: &mut Vec<[Vec3; 3]>,
+) -> usize {
     out.clear();
     let rule = options.split_rule(warps.x_table().len(), warps.y_table().len());
     let splitter = RtwSplitter {
@@ -177,14 +238,79 @@ pub fn subdivide_for_rtw_with(
         error_scale: rule.error_scale,
     };
     let levels = rule.levels;
+    let planes = planes.get(..MAX_CLIP_PLANES).unwrap_or(planes);
     for &t in triangles {
-        if t.iter().all(|p| p.is_finite() && splitter.uv(*p).is_some()) {
-            splitter.split(t, levels, out);
-        } else {
-            out.push(t);
+        for piece in cut_at_planes(t, planes) {
+            if piece
+                .iter()
+                .all(|p| p.is_finite() && splitter.uv(*p).is_some())
+            {
+                splitter.split(piece, levels, out);
+            }
         }
     }
     out.len()
+}
+
+/// Most pieces of a triangle cut by [`MAX_CLIP_PLANES`] planes (each cut at most
+/// doubles them).
+const MAX_CUT_PIECES: usize = 1 << MAX_CLIP_PLANES;
+
+/// The part of a triangle in front of every plane, as triangles (same winding).
+fn cut_at_planes(t: [Vec3; 3], planes: &[ClipPlane<'_>]) -> ArrayVec<[Vec3; 3], MAX_CUT_PIECES> {
+    let mut pieces = ArrayVec::new();
+    pieces.push(t);
+    for plane in planes {
+        let mut next = ArrayVec::new();
+        for piece in &pieces {
+            for cut in cut_at_plane(*piece, *plane).into_iter().flatten() {
+                let _ = next.try_push(cut);
+            }
+        }
+        pieces = next;
+    }
+    pieces
+}
+
+/// The part of a triangle in front of the plane where `distance >= 0`: the triangle
+/// itself, nothing, or one or two triangles (same winding) with the crossing points
+/// of its edges, each interpolated from the edge's end in front.
+fn cut_at_plane(t: [Vec3; 3], distance: ClipPlane<'_>) -> [Option<[Vec3; 3]>; 2] {
+    let d = t.map(distance);
+    let front = d.map(|x| x >= 0.0);
+    match front.iter().filter(|f| **f).count() {
+        3 => return [Some(t), None],
+        0 => return [None, None],
+        _ => {}
+    }
+    // Walk the edges, keeping the vertices in front and the crossings.
+    let mut poly = [Vec3::ZERO; 4];
+    let mut n = 0;
+    for i in 0..3 {
+        let j = (i + 1) % 3;
+        if front[i] {
+            poly[n] = t[i];
+            n += 1;
+        }
+        if front[i] != front[j] {
+            let (a, b, da, db) = if front[i] {
+                (t[i], t[j], d[i], d[j])
+            } else {
+                (t[j], t[i], d[j], d[i])
+            };
+            let s = da / (da - db);
+            poly[n] = (a.as_dvec3() + (b.as_dvec3() - a.as_dvec3()) * s).as_vec3();
+            n += 1;
+        }
+    }
+    match n {
+        3 => [Some([poly[0], poly[1], poly[2]]), None],
+        4 => [
+            Some([poly[0], poly[1], poly[2]]),
+            Some([poly[0], poly[2], poly[3]]),
+        ],
+        _ => [None, None],
+    }
 }
 
 /// The per-edge split rule of [`subdivide_for_rtw`].
@@ -390,14 +516,103 @@ mod tests {
         assert_eq!(ea, eb);
     }
 
+    /// Pieces wholly behind the clip plane are left out, those in front are kept
+    /// and split as without clipping, and a triangle across the plane is cut at it:
+    /// its two halves cover it, every piece on its own side.
     #[test]
-    fn unmappable_or_non_finite_triangles_pass_through() {
+    fn clipped_pieces_are_left_out_or_cut() {
         let warps = warps();
         let shadow = shadow(&warps);
+        let base = |p: Vec3| shadow.base.project(p).map(|s| s.uv);
+        let plane = |p: Vec3| f64::from(p.x) - 0.5;
+        let options = RtwSubdivision::default().with_max_span_cells(1.0);
+        let (mut clipped, mut plain) = (Vec::new(), Vec::new());
+        let front = [
+            Vec3::new(0.6, 0.1, 0.5),
+            Vec3::new(0.9, 0.2, 0.5),
+            Vec3::new(0.7, 0.9, 0.5),
+        ];
+        let behind = front.map(|p| Vec3::new(1.0 - p.x, p.y, p.z));
+        let n =
+            subdivide_for_rtw_clipped(base, &[&plane], &warps, &[front], &options, &mut clipped);
+        assert_eq!(
+            n,
+            subdivide_for_rtw(&shadow, &[front], &options, &mut plain)
+        );
+        assert_eq!(clipped, plain);
+        let both = [front, behind];
+        subdivide_for_rtw_clipped(base, &[&plane], &warps, &both, &options, &mut clipped);
+        assert_eq!(clipped, plain);
+        let across = [
+            Vec3::new(0.1, 0.1, 0.5),
+            Vec3::new(0.9, 0.2, 0.5),
+            Vec3::new(0.5, 0.9, 0.5),
+        ];
+        let mut halves = 0.0;
+        for side in [1.0, -1.0] {
+            let signed = |p: Vec3| side * plane(p);
+            subdivide_for_rtw_clipped(base, &[&signed], &warps, &[across], &options, &mut clipped);
+            assert!(clipped.len() > 4);
+            assert!(clipped.iter().flatten().all(|p| signed(*p) >= -1e-6));
+            // Same winding as the input.
+            let normal = |t: &[Vec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]).z;
+            assert!(clipped.iter().all(|t| normal(t) >= 0.0) && normal(&across) > 0.0);
+            halves += clipped.iter().map(area).sum::<f32>();
+        }
+        assert!((halves - area(&across)).abs() < 1e-5, "{halves}");
+    }
+
+    #[test]
+    fn the_cap_covers_the_extent_in_pieces_of_the_span_bound() {
+        let o = RtwSubdivision::default();
+        assert_eq!(o.with_segments_for_extent(1.0, 256).max_segments, 128);
+        assert_eq!(o.with_segments_for_extent(2.5, 256).max_segments, 320);
+        // Never below the current cap, never above 1024; NaN changes nothing.
+        assert_eq!(o.with_segments_for_extent(0.1, 256).max_segments, 32);
+        assert_eq!(o.with_segments_for_extent(1e9, 256).max_segments, 1024);
+        assert_eq!(o.with_segments_for_extent(f64::NAN, 256).max_segments, 32);
+        let rule = o.with_segments_for_extent(1.0, 256).split_rule(256, 256);
+        assert_eq!(rule.levels, 7);
+    }
+
+    #[test]
+    fn unmappable_or_non_finite_triangles_are_dropped() {
+        let warps = warps();
+        let shadow = shadow(&warps);
+        let good = [
+            Vec3::new(0.1, 0.1, 0.5),
+            Vec3::new(0.2, 0.1, 0.5),
+            Vec3::new(0.1, 0.2, 0.5),
+        ];
         let bad = [Vec3::NAN, Vec3::X, Vec3::Y];
         let mut out = Vec::new();
         let options = RtwSubdivision::default();
-        assert_eq!(subdivide_for_rtw(&shadow, &[bad], &options, &mut out), 1);
-        assert!(out[0][0].is_nan());
+        let kept = subdivide_for_rtw(&shadow, &[good], &options, &mut out);
+        assert!(kept >= 1);
+        assert_eq!(
+            subdivide_for_rtw(&shadow, &[bad, good], &options, &mut out),
+            kept
+        );
+        assert!(out.iter().flatten().all(|p| p.is_finite()));
+        // Behind a perspective light (w <= 0): dropped.
+        let base = ShadowTransform::new(
+            Mat4::IDENTITY,
+            // w = -z: the light at the origin looking down -z.
+            Mat4::from_cols_array(&[
+                1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0, -1.0, 0.0, 0.0, -0.1, 0.0,
+            ]),
+            false,
+            LightDirection::Position(Vec3::ZERO),
+        );
+        let spot = RtwShadow {
+            base,
+            warps: &warps,
+        };
+        let behind = [
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(0.1, 0.0, -1.0),
+            Vec3::new(0.0, 0.0, 1.0),
+        ];
+        assert_eq!(subdivide_for_rtw(&spot, &[behind], &options, &mut out), 0);
     }
 }

@@ -143,6 +143,21 @@ pub fn inverse_warp(table: &[f32], w: f32) -> f32 {
     inverse_warp_f64(table, f64::from(w)) as f32
 }
 
+/// The slope `d u' / d u` of the forward warp of a table at `u`: constant between
+/// texel centres, 1 outside them (where the warp is a translation).
+pub(crate) fn warp_slope(table: &[f32], u: f64) -> f64 {
+    let n = table.len() as f64;
+    let x = u * n - 0.5;
+    if !(x > 0.0 && x < n - 1.0) {
+        return 1.0;
+    }
+    let i = x as usize;
+    match (table.get(i), table.get(i + 1)) {
+        (Some(a), Some(b)) => 1.0 + (f64::from(*b) - f64::from(*a)) * n,
+        _ => 1.0,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,7 +7,7 @@ use shadowmap_frustum::{ShadowMapping, ShadowSample, ShadowTransform, math};
 
 use crate::RtwError;
 use crate::importance::{ImportanceMap, MAX_MAP_CELLS, MAX_MAP_SIDE};
-use crate::table::{forward_warp, forward_warp_f64, inverse_warp};
+use crate::table::{forward_warp, forward_warp_f64, inverse_warp, warp_slope};
 
 #[cfg(feature = "serde")]
 mod serde_impls;
@@ -563,6 +563,15 @@ impl ShadowMapping for RtwShadow<'_> {
 }
 
 impl WarpMaps {
+    /// How much the warp magnifies base texture space at `uv`: the slopes
+    /// `(d u' / d u, d v' / d v)` of the piecewise-linear warp there (1 outside the
+    /// tables' texel centres, where it is a translation). A map of `N` texels per side
+    /// has `N` times these texels per unit of base `uv`.
+    #[must_use]
+    pub fn magnification(&self, uv: glam::DVec2) -> glam::DVec2 {
+        glam::DVec2::new(warp_slope(&self.x, uv.x), warp_slope(&self.y, uv.y))
+    }
+
     /// A base map's sample with its `uv` warped by these tables (in `f64`, the
     /// function the shader evaluates in `f32`); depth and layer unchanged. `None` for
     /// a non-finite result. Any base mapping (a matrix, a paraboloid side) is warped
@@ -686,6 +695,37 @@ mod tests {
         w.reset_history();
         w.build(&b, &opts).unwrap();
         assert_eq!(w.density_x(), &[0.1, 0.1, 0.1, 1.0]);
+    }
+
+    /// The magnification is the warp's slope: it follows the density (the warp gives
+    /// a cell a share of the map in proportion to its density) and is 1 outside the
+    /// texel centres.
+    #[test]
+    fn magnification_is_the_slope_of_the_warp() {
+        let mut m = ImportanceMap::new(8, 2).unwrap();
+        m.copy_from_slice(&[
+            4.0, 4.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0,
+        ])
+        .unwrap();
+        let opts = WarpOptions::default().with_blur_radius(0).with_floor(0.01);
+        let mut w = WarpMaps::new(8, 2).unwrap();
+        w.build(&m, &opts).unwrap();
+        for u in [0.2, 0.33, 0.5, 0.61, 0.8] {
+            let h = 1e-7;
+            let slope = (forward_warp_f64(w.x_table(), u + h)
+                - forward_warp_f64(w.x_table(), u - h))
+                / (2.0 * h);
+            let mag = w.magnification(glam::DVec2::new(u, 0.5));
+            assert!((mag.x - slope).abs() < 1e-6, "{u}: {mag} {slope}");
+        }
+        // Dense columns (0, 1) get four times the texels of the others.
+        let dense = w.magnification(glam::DVec2::new(0.125, 0.5)).x;
+        let sparse = w.magnification(glam::DVec2::new(0.7, 0.5)).x;
+        assert!((dense / sparse - 4.0).abs() < 0.05, "{dense} {sparse}");
+        assert_eq!(
+            w.magnification(glam::DVec2::new(0.01, 0.9)),
+            glam::DVec2::ONE
+        );
     }
 
     /// Fuzz regression: a nearly flat tail (floor 1e-6) packs many knots closer than

@@ -216,7 +216,7 @@ pub fn check_cube(input: &CubeInput, valid: bool) -> Result<(), String> {
 }
 
 /// The smallest near plane of any face, as [`CubeMap::fit`] documents it.
-fn near_floor(input: &CubeInput, position: Vec3, range: f32) -> f64 {
+pub(crate) fn near_floor(input: &CubeInput, position: Vec3, range: f32) -> f64 {
     let scale = range.max(position.abs().max_element());
     f64::from(input.options.near).max(f64::from(scale) / 131_072.0)
 }

@@ -31,6 +31,8 @@ pub mod rtw;
 #[cfg(feature = "serde")]
 pub mod serde_check;
 #[cfg(feature = "warp")]
+pub mod spot_warp;
+#[cfg(feature = "warp")]
 pub mod warp;
 
 /// The configuration every property test uses: 1,000 cases from a fixed seed, so a
@@ -47,6 +49,37 @@ pub fn proptest_config() -> ProptestConfig {
 
 /// Result of a generator.
 pub type GenResult<T> = arbitrary::Result<T>;
+
+/// `len` pseudo-random bytes from an xorshift stream (`state`, advanced): the input
+/// of a generator in tests that count how often it reaches a case.
+pub fn xorshift_bytes(state: &mut u64, len: usize) -> Vec<u8> {
+    (0..len)
+        .map(|_| {
+            *state ^= *state << 13;
+            *state ^= *state >> 7;
+            *state ^= *state << 17;
+            (*state >> 24) as u8
+        })
+        .collect()
+}
+
+/// Measured depth bounds inside `[near, far]` half of the time, `None` otherwise.
+pub fn depth_bounds_in(
+    u: &mut Unstructured<'_>,
+    near: f32,
+    far: f32,
+) -> GenResult<Option<shadowmap_frustum::DepthBounds>> {
+    Ok(if u.arbitrary()? {
+        let a = in_range(u, near, far)?;
+        let b = in_range(u, near, far)?;
+        Some(shadowmap_frustum::DepthBounds {
+            min: a.min(b),
+            max: a.max(b),
+        })
+    } else {
+        None
+    })
+}
 
 /// A proptest strategy running `generate` on random bytes.
 ///

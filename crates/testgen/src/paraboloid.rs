@@ -66,16 +66,7 @@ pub fn ipsm_options(u: &mut Unstructured<'_>) -> GenResult<IpsmOptions> {
 pub fn plan_input(u: &mut Unstructured<'_>) -> GenResult<PlanInput> {
     let camera = camera(u)?;
     let (near, far) = camera.depth_range().unwrap_or((0.1, 100.0));
-    let bounds = if u.arbitrary()? {
-        let a = in_range(u, near, far)?;
-        let b = in_range(u, near, far)?;
-        Some(DepthBounds {
-            min: a.min(b),
-            max: a.max(b),
-        })
-    } else {
-        None
-    };
+    let bounds = crate::depth_bounds_in(u, near, far)?;
     let (lo, hi) = match bounds {
         Some(b) => b.clamped_to(&camera).unwrap_or((near, far)),
         None => (near, far),

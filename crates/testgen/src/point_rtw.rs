@@ -1,15 +1,17 @@
-//! Generators and checks for RTW over the IPSM paraboloid (fitted by the umbrella
-//! crate's `fit`; the fuzz target and the property test pass the fitted mapping in).
+//! Generators and checks for RTW over the IPSM paraboloid and over the cube map's
+//! faces (fitted by the umbrella crate's `fit`; the fuzz target and the property
+//! tests pass the fitted mapping in).
 
 use arbitrary::Unstructured;
 use glam::DVec2;
 use shadowmap_frustum::ShadowMapping;
-use shadowmap_paraboloid::ParaboloidMap;
+use shadowmap_paraboloid::{CubeMap, ParaboloidMap};
 use shadowmap_rtw::EyeSample;
 
-use crate::GenResult;
+use crate::cube::{CubeInput, cube_input, near_floor, visible_points};
 use crate::paraboloid::{PlanInput, plan_input};
 use crate::rtw::frustum_samples;
+use crate::{GenResult, log_uniform, unit_vec3};
 
 /// Input of [`check_point_rtw`]: an IPSM plan input and eye samples in its camera's
 /// frustum.
@@ -58,4 +60,109 @@ pub fn check_point_rtw(
         checked += 1;
     }
     checked
+}
+
+/// Input of [`check_cube_samples`]: a cube input (the light inside the view, next to
+/// a corner, far away, inside a caster's bounds, ...) and eye samples on its visible
+/// receivers, each with its own normal or none.
+#[derive(Clone, Debug)]
+pub struct CubeSamplesCase {
+    /// Light, camera, depth bounds, scene and options.
+    pub cube: CubeInput,
+    /// What the eye sees: points of the visible receivers.
+    pub samples: Vec<EyeSample>,
+    /// The image's focal length in pixels.
+    pub pixels_per_radian: f32,
+}
+
+/// A valid cube input with samples at the visible receivers' points (see
+/// [`visible_points`]).
+pub fn cube_samples_case(u: &mut Unstructured<'_>) -> GenResult<CubeSamplesCase> {
+    let cube = cube_input(u)?;
+    let eye = cube.camera.eye();
+    let mut samples = Vec::new();
+    for p in visible_points(&cube) {
+        let normal = if u.arbitrary()? {
+            unit_vec3(u)?
+        } else {
+            glam::Vec3::ZERO
+        };
+        samples.push(EyeSample {
+            position: p,
+            normal,
+            eye_distance: p.distance(eye),
+        });
+    }
+    let pixels_per_radian = log_uniform(u, 1.0, 4000.0)?;
+    Ok(CubeSamplesCase {
+        cube,
+        samples,
+        pixels_per_radian,
+    })
+}
+
+/// A cube map fitted to a case's samples (`cube`, the fitted map; `mapping`, the
+/// technique's lookup: the cube itself or RTW over its faces) covers every sample
+/// beyond the near floor and within the light's range: the cube stores it in a kept
+/// face, and `mapping` maps it into the same layer, inside `[0, 1]²` (up to
+/// rounding), at the cube's depth. The faces' sizes are positive and their atlas
+/// within `budget` (unless at its smallest, four texels a side). Returns how many
+/// samples were checked.
+///
+/// # Errors
+/// A description of the violated clause.
+pub fn check_cube_samples(
+    case: &CubeSamplesCase,
+    cube: &CubeMap,
+    mapping: &impl ShadowMapping,
+    budget: u64,
+) -> Result<usize, String> {
+    let shadowmap_frustum::Light::Point { position, range } = case.cube.light else {
+        return Err("a cube for a non-point light".into());
+    };
+    let smallest = cube.faces.iter().all(|f| f.size == [4, 4]);
+    if cube.faces.iter().any(|f| f.size.contains(&0)) || (cube.texels() > budget && !smallest) {
+        return Err(format!(
+            "sizes {:?} in {:?} over {budget}",
+            cube.faces, cube.atlas
+        ));
+    }
+    let floor = near_floor(&case.cube, position, range);
+    let tol = 1e-4;
+    let inside =
+        |uv: DVec2| uv.cmpge(DVec2::splat(-tol)).all() && uv.cmple(DVec2::splat(1.0 + tol)).all();
+    let mut checked = 0;
+    for s in &case.samples {
+        let p = s.position.as_dvec3();
+        let q = p - position.as_dvec3();
+        let scale = f64::from(
+            s.position
+                .abs()
+                .max_element()
+                .max(position.abs().max_element()),
+        );
+        // f32 rounding of the sample and of the fitted windows.
+        if q.abs().max_element() <= 1.01 * floor + 1e-3 * scale
+            || q.length() >= 0.99 * f64::from(range)
+        {
+            continue;
+        }
+        let Some(c) = cube.map_point(p) else {
+            return Err(format!("sample {} in no face", s.position));
+        };
+        let Some(m) = mapping.map_point(p) else {
+            return Err(format!(
+                "sample {} stored by the cube, not by the technique",
+                s.position
+            ));
+        };
+        if !(m.uv.is_finite() && inside(m.uv)) || m.layer != c.layer || m.depth != c.depth {
+            return Err(format!(
+                "sample {}: cube {c:?}, technique {m:?}",
+                s.position
+            ));
+        }
+        checked += 1;
+    }
+    Ok(checked)
 }

@@ -82,6 +82,14 @@ pub(crate) fn smoothstep(lo: f64, hi: f64, x: f64) -> f64 {
     if !(hi > lo) {
         return if x >= hi { 1.0 } else { 0.0 };
     }
+    // The clamped ends without the division (rounding is monotonic, so the quotient
+    // clamps the same way).
+    if x <= lo {
+        return 0.0;
+    }
+    if x >= hi {
+        return 1.0;
+    }
     let t = ((x - lo) / (hi - lo)).clamp(0.0, 1.0);
     t * t * (3.0 - 2.0 * t)
 }
@@ -161,12 +169,7 @@ pub(crate) fn light_unit(direction: Vec3) -> Result<DVec3, WarpError> {
 /// up term full weight far from the view axis cancels where the warps are strong,
 /// and points the warp backward on one side of that point.)
 pub(crate) fn frame(light: DVec3, forward: DVec3, cam_up: DVec3) -> (DMat4, f64) {
-    let v_perp = forward - light * forward.dot(light);
-    let sin_g = v_perp.length().min(1.0);
-    let u_perp = cam_up - light * cam_up.dot(light);
-    let c = FRAME_UP_WEIGHT * (1.0 - smoothstep(FRAME_BLEND_LO, FRAME_BLEND_HI, sin_g));
-    let mut up = v_perp + u_perp.normalize_or_zero() * c;
-    up -= light * up.dot(light);
+    let (up, sin_g) = frame_axis(light, forward, cam_up);
     let up = up.try_normalize().unwrap_or_else(|| {
         // Only on the two (measure-zero) directions where the blend cancels: any
         // axis perpendicular to the light keeps the frame valid.
@@ -182,6 +185,19 @@ pub(crate) fn frame(light: DVec3, forward: DVec3, cam_up: DVec3) -> (DMat4, f64)
         DVec4::W,
     );
     (rot, sin_g)
+}
+
+/// The warp axis of [`frame`] before it is normalized, `a = g + c(|g|) u` made
+/// perpendicular to the light, and `sin γ = |g|`. Its length is the distance (in
+/// radians, for small ones) of the light from the two directions where the frame
+/// has no axis: near them the frame turns about the light as fast as one over it.
+pub(crate) fn frame_axis(light: DVec3, forward: DVec3, cam_up: DVec3) -> (DVec3, f64) {
+    let v_perp = forward - light * forward.dot(light);
+    let sin_g = v_perp.length().min(1.0);
+    let u_perp = cam_up - light * cam_up.dot(light);
+    let c = FRAME_UP_WEIGHT * (1.0 - smoothstep(FRAME_BLEND_LO, FRAME_BLEND_HI, sin_g));
+    let up = v_perp + u_perp.normalize_or_zero() * c;
+    (up - light * up.dot(light), sin_g)
 }
 
 /// Checked scene boxes.
@@ -219,18 +235,22 @@ pub(crate) struct Focus {
     pub(crate) casters: Points,
     /// The checked caster box.
     pub(crate) caster_box: Aabb,
+    /// What every fit of the body reads, whatever its warp, computed once: the
+    /// light-space bounds of `casters`, ...
+    pub(crate) light_bounds: Bounds,
+    /// ... the largest coordinate of `casters` ([`scale_of`]) in world and in light
+    /// space and of `receivers` in world space, ...
+    pub(crate) caster_scale: f64,
+    pub(crate) light_caster_scale: f64,
+    pub(crate) receiver_scale: f64,
+    /// ... and how far the receivers' footprint is from thin ([`footprint_weight`]).
+    pub(crate) wide: f64,
 }
 
 impl Focus {
     /// Smallest and largest light-space `y` (the warp axis) of the caster body.
     pub(crate) fn warp_axis_range(&self) -> (f64, f64) {
-        let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
-        for p in &self.casters {
-            let y = self.rot.transform_point3(*p).y;
-            y0 = y0.min(y);
-            y1 = y1.max(y);
-        }
-        (y0, y1)
+        (self.light_bounds.min.y, self.light_bounds.max.y)
     }
 }
 
@@ -244,11 +264,32 @@ pub(crate) fn focus(view: &View, light: Vec3, scene: &SceneBounds) -> Result<Foc
     }
     let (rot, sin_gamma) = frame(dir, view.forward, view.up);
     let receivers: ReceiverPoints = body.iter().map(|v| v.as_dvec3()).collect();
-    let casters = caster_points(&rot, &receivers, &casters);
+    // The receivers' light-space bounds: the caster prism's and the footprint's.
+    let mut footprint = Bounds::EMPTY;
+    let mut light_caster_scale = f64::MIN_POSITIVE;
+    for p in &receivers {
+        let q = rot.transform_point3(*p);
+        footprint.add(q);
+        light_caster_scale = light_caster_scale.max(q.abs().max_element());
+    }
+    let casters = caster_points(&rot, &receivers, &footprint, &casters);
+    // The casters start with the receivers.
+    let mut light_bounds = footprint;
+    for p in &casters[receivers.len()..] {
+        let q = rot.transform_point3(*p);
+        light_bounds.add(q);
+        light_caster_scale = light_caster_scale.max(q.abs().max_element());
+    }
+    let receiver_scale = scale_of(&receivers);
     Ok(Focus {
         light: dir,
         rot,
         sin_gamma,
+        wide: footprint_weight(&footprint, receiver_scale),
+        caster_scale: scale_of(&casters),
+        light_caster_scale,
+        receiver_scale,
+        light_bounds,
         receivers,
         casters,
         caster_box: scene.casters,
@@ -398,16 +439,12 @@ pub const MIN_RELATIVE_EXTENT: f64 = 0.007_812_5;
 /// relative to `L`: enough for `f32` matrices to stay invertible.
 const MIN_PAD_EXTENT: f64 = 1e-5;
 
-/// How far the light-space footprint (`x`, `y`) of `points` is from thin, in
+/// How far the light-space footprint (`x`, `y`) `b` of points is from thin, in
 /// `[0, 1]`: 0 when its smaller side is at most [`MIN_RELATIVE_EXTENT`] times
 /// `scale`, 1 from four times that, smooth between. Fits scale their warp by it and widen
 /// the footprint by `1 -` it, so a region that thins out turns continuously into the
 /// widened uniform fit.
-pub(crate) fn footprint_weight(rot: &DMat4, points: &[DVec3], scale: f64) -> f64 {
-    let mut b = Bounds::EMPTY;
-    for p in points {
-        b.add(rot.transform_point3(*p));
-    }
+pub(crate) fn footprint_weight(b: &Bounds, scale: f64) -> f64 {
     let ext = b.max - b.min;
     let min = MIN_RELATIVE_EXTENT * scale;
     let t = smoothstep(1.0, 4.0, ext.x.min(ext.y) / min);
@@ -422,12 +459,8 @@ pub(crate) fn footprint_weight(rot: &DMat4, points: &[DVec3], scale: f64) -> f64
 /// (`ConvexBody::extruded_toward_light` of `shadowmap-frustum` is not used: its hull
 /// misses casters when the ray toward the light leaves the scene box through a side
 /// face.)
-fn caster_points(rot: &DMat4, receivers: &[DVec3], caster_box: &Aabb) -> Points {
+fn caster_points(rot: &DMat4, receivers: &[DVec3], b: &Bounds, caster_box: &Aabb) -> Points {
     let mut out: Points = receivers.iter().copied().collect();
-    let mut b = Bounds::EMPTY;
-    for p in receivers {
-        b.add(rot.transform_point3(*p));
-    }
     let (lo, hi) = (caster_box.min.as_dvec3(), caster_box.max.as_dvec3());
     let scale = lo
         .abs()
@@ -438,10 +471,10 @@ fn caster_points(rot: &DMat4, receivers: &[DVec3], caster_box: &Aabb) -> Points 
     // Light-space x and y of a world point (rows of the rotation).
     let row = |r: usize| DVec3::new(rot.x_axis[r], rot.y_axis[r], rot.z_axis[r]);
     let (rx, ry, rz) = (row(0), row(1), row(2));
-    let in_prism = |p: DVec3| {
-        let (x, y) = (rx.dot(p), ry.dot(p));
+    let in_prism_xy = |x: f64, y: f64| {
         x >= b.min.x - tol && x <= b.max.x + tol && y >= b.min.y - tol && y <= b.max.y + tol
     };
+    let in_prism = |p: DVec3| in_prism_xy(rx.dot(p), ry.dot(p));
     let in_box =
         |p: DVec3| p.cmpge(lo - DVec3::splat(tol)).all() && p.cmple(hi + DVec3::splat(tol)).all();
     let mut cands: ArrayVec<DVec3, 128> = ArrayVec::new();
@@ -455,9 +488,11 @@ fn caster_points(rot: &DMat4, receivers: &[DVec3], caster_box: &Aabb) -> Points 
             if i & 4 == 0 { lo.z } else { hi.z },
         )
     };
+    // The corners' light-space x and y, shared by the edges that end there.
+    let light_xy: [[f64; 2]; 8] = core::array::from_fn(|i| [rx.dot(corner(i)), ry.dot(corner(i))]);
     for i in 0..8 {
         let p = corner(i);
-        if in_prism(p) {
+        if in_prism_xy(light_xy[i][0], light_xy[i][1]) {
             let _ = cands.try_push(p);
         }
         for bit in [1usize, 2, 4] {
@@ -465,8 +500,8 @@ fn caster_points(rot: &DMat4, receivers: &[DVec3], caster_box: &Aabb) -> Points 
                 continue;
             }
             let q = corner(i | bit);
-            for (axis, value) in [(rx, b.min.x), (rx, b.max.x), (ry, b.min.y), (ry, b.max.y)] {
-                let (a, c) = (axis.dot(p), axis.dot(q));
+            for (axis, value) in [(0, b.min.x), (0, b.max.x), (1, b.min.y), (1, b.max.y)] {
+                let (a, c) = (light_xy[i][axis], light_xy[i | bit][axis]);
                 if (a - value) * (c - value) < 0.0 {
                     let x = p + (q - p) * ((value - a) / (c - a));
                     if in_prism(x) {
@@ -619,11 +654,6 @@ pub(crate) fn matrix_ok(m: &Mat4) -> bool {
     }
     let det = m.as_dmat4().determinant();
     det.is_finite() && det != 0.0 && (det as f32) != 0.0 && m.inverse().is_finite()
-}
-
-/// Light-space coordinates of world points.
-pub(crate) fn transform_points(m: &DMat4, pts: &[DVec3]) -> Points {
-    pts.iter().map(|p| m.transform_point3(*p)).collect()
 }
 
 /// `sqrt` that never returns NaN for tiny negative rounding.

@@ -22,6 +22,10 @@
 //!   with Trapezoidal Shadow Maps*, EGSR 2004) with the 80% focus rule.
 //! - [`warped_cascades`]: LiSPSM (or uniform) per parallel split (PSSM + LiSPSM) with a
 //!   strength per cascade.
+//! - [`spot_warp`]: LiSPSM and TSM for a spot light, in its post-projective space
+//!   (after the spot fit of `shadowmap-frustum`, where its rays are parallel): a
+//!   homography of the fit's device plane along the view's centre line (see the
+//!   [`spot_warp`] docs).
 //!
 //! # Example
 //!
@@ -102,8 +106,21 @@
 //!   near or far ground point changes by more than 2% per step, and no warp's
 //!   largest texel-to-pixel ratio over the view exceeds 1.1 times the uniform fit's.
 //!   Not covered: a light grazing the ground (within 2°), where TSM's texel sizes
-//!   change by more than 2% per 0.01° (continuously), and a light from below the
-//!   ground, where LiSPSM and XPSM can exceed the uniform fit's largest error;
+//!   change by up to 3% per 0.01° (continuously), and a light from below the
+//!   ground, where XPSM can exceed the uniform fit's largest error by 12%: no
+//!   surface in view is lit there, so nothing shows a shadow, and the prediction has
+//!   nothing to choose the strength by (the warps keep their formula's; fading them
+//!   to the uniform fit instead must happen over the 3° band in which the ground
+//!   turns lit, which made TSM's texels change by 12% per 0.01°, and spreading it
+//!   wider cost the 7° sun of the report's grazing configuration half its gain).
+//!   The two light directions where the light frame has no axis (1° from the view
+//!   axis and its opposite, see [`light_frame`]): no frame field on the sphere of
+//!   directions is free of zeros, so near them the matrices turn fast about the
+//!   light; the fits' boxes there are widened toward the footprint's diameter on
+//!   both sides, which fits it in any orientation, so texel sizes stay continuous
+//!   (under 0.4% per 1e-4 rad of light passing them at any distance; every warp has
+//!   faded to the uniform fit there, and the box is at most `sqrt 2` larger within
+//!   about a degree of them);
 //! - a warp that would not pay (its formula's strength predicted worse than, or
 //!   about as good as, the uniform fit over the focus body: a camera inside a
 //!   large scene, looking down, a wall the light grazes): LiSPSM, TSM and XPSM
@@ -161,6 +178,7 @@ mod lispsm;
 mod predict;
 #[cfg(feature = "serde")]
 mod serde_impls;
+mod spot;
 mod tsm;
 mod uniform;
 mod warped_mapping;
@@ -172,6 +190,7 @@ pub use focus::{FocusBody, MAX_MAP_SIDE, MAX_WARP_RATIO, MIN_RELATIVE_EXTENT, Pa
 pub use lispsm::{LispsmOptions, LispsmShadow, lispsm};
 pub use shadowmap_frustum::SceneBounds;
 pub use shadowmap_frustum::{ShadowTransform, glam};
+pub use spot::{SpotWarpKind, SpotWarpOptions, SpotWarpShadow, spot_warp};
 pub use tsm::{TsmOptions, TsmShadow, tsm};
 pub use uniform::{UniformOptions, uniform_focused};
 pub use warped_mapping::WarpedCascadesView;

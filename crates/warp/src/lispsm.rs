@@ -1,12 +1,11 @@
 //! Light space perspective shadow maps (LiSPSM).
 
-use glam::{DMat4, DVec3, DVec4, Vec3};
+use glam::{DMat4, DVec4, Vec3};
 use shadowmap_frustum::{Camera, ShadowTransform, math};
 
 use crate::WarpError;
 use crate::focus::{
-    Bounds, Focus, FocusBody, View, finish, footprint_weight, ortho_fit, scale_of, sqrt0,
-    transform_points,
+    Bounds, Focus, FocusBody, View, finish, frame_axis, ortho_fit, smoothstep, sqrt0,
 };
 use crate::predict::{self, Probe};
 use crate::{MAX_WARP_RATIO, ParallelFade, SceneBounds};
@@ -250,16 +249,12 @@ pub(crate) fn warp_clip(
     s: f64,
     reversed_z: bool,
 ) -> Result<(DMat4, f64, f64), WarpError> {
-    let ls_casters = transform_points(&f.rot, &f.casters);
-    let mut lb = Bounds::EMPTY;
-    for p in &ls_casters {
-        lb.add(*p);
-    }
-    let scale = scale_of(&f.casters);
+    let lb = &f.light_bounds;
+    let scale = f.caster_scale;
     // A footprint too thin for f32 texels gets the widened uniform fit.
-    let wide = footprint_weight(&f.rot, &f.receivers, scale_of(&f.receivers));
+    let wide = f.wide;
     let s = (s * wide)
-        .min(MAX_WARP_RATIO / scale_of(&ls_casters))
+        .min(MAX_WARP_RATIO / f.light_caster_scale)
         .max(0.0);
     let eye = f.rot.transform_point3(view.eye);
     let x_c = eye.x.max(lb.min.x).min(lb.max.x);
@@ -272,21 +267,74 @@ pub(crate) fn warp_clip(
         DVec4::new(-x_c, -y0, -z_c, 1.0 - s * y0),
     );
     let warp_from_world = warp * f.rot;
-    let project = |p: &DVec3| -> DVec3 { warp_from_world.project_point3(*p) };
     // x, y and the far plane from the receivers; the near plane from the casters.
     let mut b = Bounds::EMPTY;
     for p in &f.receivers {
-        b.add(project(p));
+        b.add(warp_from_world.project_point3(*p));
     }
+    // The projected depth alone, as `project_point3` computes it.
+    let m = &warp_from_world;
+    let (zr, wr) = (
+        DVec4::new(m.x_axis.z, m.y_axis.z, m.z_axis.z, m.w_axis.z),
+        DVec4::new(m.x_axis.w, m.y_axis.w, m.z_axis.w, m.w_axis.w),
+    );
     for p in &f.casters {
-        let q = project(p);
-        b.max.z = b.max.z.max(q.z);
+        let z = zr.x * p.x + zr.y * p.y + zr.z * p.z + zr.w;
+        let w = wr.x * p.x + wr.y * p.y + wr.z * p.z + wr.w;
+        b.max.z = b.max.z.max(z / w);
     }
     if b.is_empty() || !(b.min.is_finite() && b.max.is_finite()) {
         return Err(WarpError::Degenerate);
     }
-    let b = b.padded(scale, 1.0 - wide);
+    let b = turn_invariant(b, f, view, &warp_from_world).padded(scale, 1.0 - wide);
     Ok((ortho_fit(&b, reversed_z) * warp_from_world, s, scale))
+}
+
+/// Length of the light frame's raw axis ([`frame_axis`]) below which the box of a
+/// fit is fully turn-invariant, and above which it is the plain box (see
+/// [`turn_invariant`]); radians, for small ones.
+const TURN_INVARIANT_BAND: (f64, f64) = (0.01, 0.02);
+
+/// The fitted bounds `b` widened, near the two light directions where the light
+/// frame has no axis, toward a box whose extents do not depend on how the frame is
+/// turned about the light: both sides the diameter of the receivers' footprint.
+///
+/// No frame field on the sphere of light directions is free of zeros (the
+/// hairy-ball theorem), so near its two zeros (1° from the view axis, see
+/// [`frame`](crate::focus)) the frame turns about the light fast, and the box of the
+/// footprint, whose sides depend on that turn, with it: a step of 1e-4 rad of light
+/// passing 0.005° from a zero changed the uniform fit's texel size by 31%. A set of
+/// diameter `D` fits a box of side `D` in any orientation, so blending the sides
+/// toward `D` as the raw axis gets shorter than [`TURN_INVARIANT_BAND`] makes the
+/// texel size continuous there (the matrices still turn: no frame can avoid that).
+/// Every warp has faded to the uniform fit there, and the box is at most `sqrt 2`
+/// times larger, only within about a degree of one direction.
+pub(crate) fn turn_invariant(
+    mut b: Bounds,
+    f: &Focus,
+    view: &View,
+    warp_from_world: &DMat4,
+) -> Bounds {
+    let (axis, _) = frame_axis(f.light, view.forward, view.up);
+    let w = 1.0 - smoothstep(TURN_INVARIANT_BAND.0, TURN_INVARIANT_BAND.1, axis.length());
+    if !(w > 0.0) {
+        return b;
+    }
+    let mut diameter = 0.0f64;
+    for (i, p) in f.receivers.iter().enumerate() {
+        let p = warp_from_world.project_point3(*p).truncate();
+        for q in &f.receivers[i + 1..] {
+            let q = warp_from_world.project_point3(*q).truncate();
+            diameter = diameter.max((p - q).length());
+        }
+    }
+    for axis in 0..2 {
+        let (lo, hi) = (b.min[axis], b.max[axis]);
+        let grow = 0.5 * w * (diameter - (hi - lo)).max(0.0);
+        b.min[axis] = lo - grow;
+        b.max[axis] = hi + grow;
+    }
+    b
 }
 
 /// The strength to use for a warp whose formula asks for `s_formula`: the fraction
@@ -310,7 +358,8 @@ pub(crate) fn predicted_strength(f: &Focus, view: &View, s_formula: f64) -> f64 
             (math::exp(t * ln_r) - 1.0) / d
         }
     };
-    let probe = Probe::new(view, f);
+    let mut probe = Probe::new();
+    probe.fill(view, f);
     let confidence = probe.confidence();
     if !(confidence > 0.0) {
         return s_formula;

@@ -36,7 +36,7 @@
 
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec3};
-use shadowmap_frustum::math;
+use shadowmap_frustum::math::{self, max_num, min_num};
 
 use crate::focus::{Bounds, Focus, View, smoothstep};
 
@@ -63,6 +63,14 @@ struct Point {
     weight: f64,
 }
 
+/// A neighbouring pixel's ray (see [`Screen::neighbours`]).
+#[derive(Clone, Copy)]
+struct Neighbour {
+    origin: DVec3,
+    dir: DVec3,
+    length: f64,
+}
+
 /// The probe points of a focus body.
 #[derive(Clone, Debug)]
 pub(crate) struct Probe {
@@ -79,15 +87,44 @@ struct Screen {
     eye: DVec3,
 }
 
+/// The points at horizontal position `x` on the bottom and top edges of the near and
+/// far faces: the ray through `(x, y)` runs between their interpolations at `y`
+/// ([`Screen::ray_between`]).
+#[derive(Clone, Copy)]
+struct Edges {
+    near: (DVec3, DVec3),
+    far: (DVec3, DVec3),
+}
+
 impl Screen {
-    fn ray(&self, at: DVec2) -> (DVec3, DVec3) {
-        let bilerp = |q: &[DVec3; 4]| {
-            let bottom = q[0].lerp(q[1], at.x);
-            let top = q[3].lerp(q[2], at.x);
-            bottom.lerp(top, at.y)
+    fn edges(&self, x: f64) -> Edges {
+        let edge = |q: &[DVec3; 4]| (q[0].lerp(q[1], x), q[3].lerp(q[2], x));
+        Edges {
+            near: edge(&self.near),
+            far: edge(&self.far),
+        }
+    }
+
+    /// The ray at height `y` between the edges.
+    fn ray_between(&self, e: &Edges, y: f64) -> (DVec3, DVec3) {
+        let origin = e.near.0.lerp(e.near.1, y);
+        (origin, e.far.0.lerp(e.far.1, y) - origin)
+    }
+
+    /// The rays through `at` moved one step in `+x`, `-x`, `+y` and `-y` (`edges`
+    /// are those of `at.x`), each with its length.
+    fn neighbours(&self, at: DVec2, step: DVec2, edges: &Edges) -> [Neighbour; 4] {
+        let ray = |(origin, dir): (DVec3, DVec3)| Neighbour {
+            origin,
+            dir,
+            length: dir.length(),
         };
-        let origin = bilerp(&self.near);
-        (origin, bilerp(&self.far) - origin)
+        [
+            ray(self.ray_between(&self.edges(at.x + step.x), at.y)),
+            ray(self.ray_between(&self.edges(at.x - step.x), at.y)),
+            ray(self.ray_between(edges, at.y + step.y)),
+            ray(self.ray_between(edges, at.y - step.y)),
+        ]
     }
 
     fn depth(&self, p: DVec3) -> f64 {
@@ -96,8 +133,17 @@ impl Screen {
 }
 
 impl Probe {
-    /// The probe points of `f` seen from `view`.
-    pub(crate) fn new(view: &View, f: &Focus) -> Self {
+    /// No probe points; [`Probe::fill`] adds them. (A probe is large: it is filled
+    /// where it lives rather than moved.)
+    pub(crate) const fn new() -> Self {
+        Self {
+            points: ArrayVec::new_const(),
+            geometric: 0.0,
+        }
+    }
+
+    /// Adds the probe points of `f` seen from `view`.
+    pub(crate) fn fill(&mut self, view: &View, f: &Focus) {
         let c = view.frustum.corners.map(glam::Vec3::as_dvec3);
         let screen = Screen {
             near: [c[0], c[1], c[2], c[3]],
@@ -111,32 +157,35 @@ impl Probe {
         for p in &f.receivers {
             b.add(*p);
         }
-        let mut points = ArrayVec::new();
-        let mut geometric = 0.0;
         for row in 0..ROWS {
             for column in 0..COLUMNS {
                 let at = DVec2::new(
                     (column as f64 + 0.5) / COLUMNS as f64,
                     (row as f64 + 0.5) / ROWS as f64,
                 );
-                geometric += ray_points(&screen, &b, at, step, f.light, &mut points);
+                self.geometric += ray_points(&screen, &b, at, step, f.light, &mut self.points);
             }
         }
-        Self { points, geometric }
     }
 
     /// The predicted error `E` of the clip matrix `clip_from_world` (infinite when
     /// a probe point falls behind its projection centre).
     pub(crate) fn error(&self, clip_from_world: &DMat4) -> f64 {
+        // Only clip x, y and w matter: the columns' (x, y, w), multiplied and summed
+        // in the order of the matrix product (a direction's zero `w` term left out).
+        let m = clip_from_world;
+        let [cx, cy, cz, cw] =
+            [m.x_axis, m.y_axis, m.z_axis, m.w_axis].map(|c| DVec3::new(c.x, c.y, c.w));
         let (mut sum, mut weights) = (0.0, 0.0);
         for q in &self.points {
-            let h = *clip_from_world * q.p.extend(1.0);
-            if !(h.w > 0.0) {
+            let h = cx * q.p.x + cy * q.p.y + cz * q.p.z + cw;
+            let hw = h.z;
+            if !(hw > 0.0) {
                 return f64::INFINITY;
             }
             let ndc = |d: DVec3| {
-                let dh = *clip_from_world * d.extend(0.0);
-                (DVec2::new(dh.x, dh.y) * h.w - DVec2::new(h.x, h.y) * dh.w) / (h.w * h.w)
+                let dh = cx * d.x + cy * d.y + cz * d.z;
+                (DVec2::new(dh.x, dh.y) * hw - DVec2::new(h.x, h.y) * dh.z) / (hw * hw)
             };
             let s = math::smaller_singular_value(ndc(q.dx), ndc(q.dy));
             if !(s > 0.0) {
@@ -166,7 +215,7 @@ impl Probe {
     }
 }
 
-/// The probe points of the ray through `at` (see [`Probe::new`]).
+/// The probe points of the ray through `at` (see [`Probe::fill`]).
 ///
 /// Where the surface a pixel sees lies is unknown; the receivers' box stands in for
 /// it: the face the ray enters through (eye outside the box), else the inner face
@@ -184,7 +233,8 @@ fn ray_points(
     light: DVec3,
     out: &mut ArrayVec<Point, { COLUMNS * ROWS * DEPTHS }>,
 ) -> f64 {
-    let (o, d) = screen.ray(at);
+    let edges = screen.edges(at.x);
+    let (o, d) = screen.ray_between(&edges, at.y);
     let (mut enter, mut exit) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
     for axis in 0..3 {
         if d[axis] == 0.0 {
@@ -193,14 +243,15 @@ fn ray_points(
             }
             continue;
         }
+        // Finite bounds and ray, `d != 0`: no NaN for `min_num` and `max_num`.
         let t0 = (b.min[axis] - o[axis]) / d[axis];
         let t1 = (b.max[axis] - o[axis]) / d[axis];
-        enter[axis] = t0.min(t1);
-        exit[axis] = t0.max(t1);
+        enter[axis] = min_num(t0, t1);
+        exit[axis] = max_num(t0, t1);
     }
-    let s_enter = enter[0].max(enter[1]).max(enter[2]);
-    let s_exit = exit[0].min(exit[1]).min(exit[2]);
-    let (s0, s1) = (s_enter.max(0.0), s_exit.min(1.0));
+    let s_enter = max_num(max_num(enter[0], enter[1]), enter[2]);
+    let s_exit = min_num(min_num(exit[0], exit[1]), exit[2]);
+    let (s0, s1) = (max_num(s_enter, 0.0), min_num(s_exit, 1.0));
     let (zn, zf) = (screen.depth(o), screen.depth(o + d));
     let depth = |s: f64| zn + s * (zf - zn);
     let (z0, z1) = (depth(s0), depth(s1));
@@ -209,29 +260,40 @@ fn ray_points(
     }
     // Rays that graze the box fade out (the clipped segment shrinks to a point) to
     // a small floor, which is every ray's weight on a flat box.
-    let ln_ratio = math::ln(z1 / z0);
-    let ray_weight = smoothstep(0.0, 0.05, ln_ratio).max(RAY_WEIGHT_FLOOR);
+    let ray_weight = log_step(z1 / z0).max(RAY_WEIGHT_FLOOR);
     let alpha = if s_enter > 0.0 {
-        smoothstep(0.0, 0.05, math::ln(z0 / zn))
+        log_step(z0 / zn)
     } else {
         0.0
     };
-    let beta = if s_exit < 1.0 {
-        smoothstep(0.0, 0.05, math::ln(zf / z1))
-    } else {
-        0.0
+    let beta = if s_exit < 1.0 { log_step(zf / z1) } else { 0.0 };
+    // The neighbouring pixels' rays, computed once for every point of this ray.
+    let mut near_rays = None;
+    let mut point = |p: DVec3, n: DVec3, weight: f64| {
+        if !(weight > 0.0) {
+            return None;
+        }
+        let rays = near_rays.get_or_insert_with(|| screen.neighbours(at, step, &edges));
+        point_at(rays, p, n, weight)
     };
-    let probe = |s: f64, n: DVec3, weight: f64| {
+    let mut probe = |s: f64, n: DVec3, weight: f64| {
         // Only front-lit surfaces matter: within about 3° of parallel to the light
         // shading darkens a surface whatever the map says (and its texels stretch
         // without bound), so such faces fade out between sin 3° and sin 6°.
         let lit = smoothstep(0.05, 0.1, -n.dot(light));
-        point_at(screen, at, step, o + d * s, n, weight * lit)
+        point(o + d * s, n, weight * lit)
     };
     let face = |s_face: f64, slabs: &[f64; 3]| {
         let mut n = DVec3::ZERO;
+        let depth_face = depth(s_face);
         for axis in 0..3 {
-            let rel = (s_face - slabs[axis]).abs() * (zf - zn) / depth(s_face);
+            let apart = (s_face - slabs[axis]).abs() * (zf - zn);
+            // Slabs far from this face's (a relative depth above 0.02 by more than
+            // rounding) add nothing: skip the division.
+            if apart >= FACE_BAND_SATURATED * depth_face {
+                continue;
+            }
+            let rel = apart / depth_face;
             let mut e = DVec3::ZERO;
             e[axis] = -d[axis].signum();
             n += e * (1.0 - smoothstep(0.0, 0.02, rel));
@@ -264,43 +326,41 @@ fn ray_points(
         return ray_weight;
     }
     let n = bisector / facing;
+    let ln_ratio = math::ln(z1 / z0);
     for k in 0..DEPTHS {
         let z = z0 * math::exp(ln_ratio * (k as f64 + 0.5) / DEPTHS as f64);
-        push(point_at(
-            screen,
-            at,
-            step,
-            o + d * ((z - zn) / (zf - zn)),
-            n,
-            w_volume,
-        ));
+        push(point(o + d * ((z - zn) / (zf - zn)), n, w_volume));
     }
     ray_weight
 }
 
-/// The probe point at `p` on the ray through `at`, on the plane through `p` with
-/// normal `n`.
-fn point_at(
-    screen: &Screen,
-    at: DVec2,
-    step: DVec2,
-    p: DVec3,
-    n: DVec3,
-    weight: f64,
-) -> Option<Point> {
-    let on_plane = |offset: DVec2| -> Option<DVec3> {
-        let (ro, rd) = screen.ray(at + offset);
+/// Above this relative depth a slab's face blend is surely 0 (see `ray_points`):
+/// `0.02` raised by a relative `1e-9`, far beyond rounding.
+const FACE_BAND_SATURATED: f64 = 0.020_000_000_02;
+
+/// `smoothstep(0, 0.05, ln x)`, the logarithm skipped where the step is 1: above
+/// `e^0.05` by a relative `1e-12` the logarithm exceeds `0.05` whatever its last
+/// bit.
+fn log_step(x: f64) -> f64 {
+    const SATURATED: f64 = 1.051_271_096_377_2; // e^0.05 (1 + 1.1e-12)
+    if x >= SATURATED {
+        1.0
+    } else {
+        smoothstep(0.0, 0.05, math::ln(x))
+    }
+}
+
+/// The probe point at `p`, on the plane through `p` with normal `n`: its screen
+/// steps are where the neighbouring pixels' rays ([`Screen::neighbours`]) meet that
+/// plane.
+fn point_at(rays: &[Neighbour; 4], p: DVec3, n: DVec3, weight: f64) -> Option<Point> {
+    let on_plane = |r: &Neighbour| -> Option<DVec3> {
+        let (ro, rd) = (r.origin, r.dir);
         let denom = n.dot(rd);
-        (denom.abs() > 1e-12 * rd.length()).then(|| ro + rd * (n.dot(p - ro) / denom))
+        (denom.abs() > 1e-12 * r.length).then(|| ro + rd * (n.dot(p - ro) / denom))
     };
-    let (xp, xm) = (
-        on_plane(DVec2::new(step.x, 0.0))?,
-        on_plane(DVec2::new(-step.x, 0.0))?,
-    );
-    let (yp, ym) = (
-        on_plane(DVec2::new(0.0, step.y))?,
-        on_plane(DVec2::new(0.0, -step.y))?,
-    );
+    let (xp, xm) = (on_plane(&rays[0])?, on_plane(&rays[1])?);
+    let (yp, ym) = (on_plane(&rays[2])?, on_plane(&rays[3])?);
     let q = Point {
         p,
         dx: (xp - xm) * 0.5,
@@ -338,10 +398,11 @@ const KEEP_BELOW: f64 = 0.9;
 /// changes, since the two parabolas then agree at the midpoint), so the strength is
 /// continuous in the camera and the light.
 pub(crate) fn choose(confidence: f64, mut error: impl FnMut(f64) -> f64) -> f64 {
+    let at = |i: usize| i as f64 / (GRID - 1) as f64;
     let mut e = [0.0f64; GRID];
-    for (i, slot) in e.iter_mut().enumerate() {
-        *slot = error(i as f64 / (GRID - 1) as f64);
-    }
+    // The ends first: they alone decide the usual cases.
+    e[0] = error(at(0));
+    e[GRID - 1] = error(at(GRID - 1));
     let q = e[GRID - 1] / e[0];
     if !(e[0].is_finite() && e[0] > 0.0) {
         // No usable prediction for the uniform fit: keep the formula (it is then the
@@ -350,6 +411,9 @@ pub(crate) fn choose(confidence: f64, mut error: impl FnMut(f64) -> f64) -> f64 
     }
     if q <= KEEP_BELOW {
         return 1.0;
+    }
+    for (i, slot) in e.iter_mut().enumerate().take(GRID - 1).skip(1) {
+        *slot = error(at(i));
     }
     let t_opt = parabola_min(&e) / (GRID - 1) as f64;
     let keep = 1.0 - smoothstep(KEEP_BELOW, 1.0, q) * confidence.clamp(0.0, 1.0);

@@ -6,7 +6,8 @@ use shadowmap_frustum::{Camera, ShadowTransform};
 
 use crate::FocusBody;
 use crate::WarpError;
-use crate::focus::{Bounds, Focus, View, finish, footprint_weight, scale_of, smoothstep};
+use crate::focus::{Bounds, Focus, View, finish, scale_of, smoothstep};
+use crate::lispsm::turn_invariant;
 use crate::predict::{self, Probe};
 use shadowmap_frustum::math;
 
@@ -266,8 +267,7 @@ fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow
     )?;
     // The lookup is evaluated at the receivers: the matrix must resolve them too (a
     // depth range spanning absurdly tall casters can leave it singular there).
-    if !shadowmap_frustum::is_invertible(&transform.clip_from_world, scale_of(&f.receivers) as f32)
-    {
+    if !shadowmap_frustum::is_invertible(&transform.clip_from_world, f.receiver_scale as f32) {
         return Err(WarpError::Degenerate);
     }
     // Step 18: Z bias scale, 1 / (MaxZ - MinZ).
@@ -308,7 +308,8 @@ fn predicted_length(view: &View, f: &Focus, options: &XpsmOptions, length: f64, 
             (math::exp(t * ln_r) - 1.0) / d
         }
     };
-    let probe = Probe::new(view, f);
+    let mut probe = Probe::new();
+    probe.fill(view, f);
     let confidence = probe.confidence();
     if !(confidence > 0.0) {
         return length;
@@ -386,7 +387,7 @@ fn xpsm_fit(
     }
     // The f32 matrix computes w in world coordinates: keep its rounding small (see
     // MAX_WARP_RATIO).
-    let world_scale = scale_of(&f.casters).max(
+    let world_scale = f.caster_scale.max(
         f.caster_box
             .min
             .abs()
@@ -396,7 +397,7 @@ fn xpsm_fit(
     );
     length_p = length_p.min(crate::MAX_WARP_RATIO / world_scale);
     // A footprint too thin for f32 texels gets the widened uniform fit.
-    let wide = footprint_weight(&f.rot, &f.receivers, scale_of(&f.receivers));
+    let wide = f.wide;
     length_p *= wide;
     if !(length_p.is_finite() && length_p >= 0.0) {
         length_p = 0.0;
@@ -451,13 +452,16 @@ fn xpsm_fit(
     // Step 14: Z range over both boxes (points with w < epsilonW excluded).
     region.min.z = cz.0.min(rz.0);
     region.max.z = cz.1.max(rz.1);
+    // Near the light frame's two zeros the region must not depend on how the frame
+    // is turned (see `turn_invariant`).
+    let region = turn_invariant(region, f, view, &(ppls * light_space));
     // Widen a thin region as the uniform fit does: relative to the focus body's
     // coordinates, where the lookup is evaluated, not to the far corners of the
     // caster box (which would make the miner's-lamp fit coarser than the uniform
     // fit of the same body).
     // (Depth keeps the padding relative to the whole caster box, which its range
     // spans.)
-    let by_body = region.padded(scale_of(&f.casters), 1.0 - wide);
+    let by_body = region.padded(f.caster_scale, 1.0 - wide);
     let by_world = region.padded(world_scale, 1.0 - wide);
     let region = Bounds {
         min: by_body.min.truncate().extend(by_world.min.z),

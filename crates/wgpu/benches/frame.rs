@@ -2,14 +2,20 @@
 //! each technique, subdividing the casters of the city block for RTW, and recording
 //! depth passes (needs an adapter; skipped without one). `rtw_frame_cpu`: the CPU
 //! cost of a whole RTW frame with the tables built and the casters refined on the
-//! GPU.
+//! GPU; `ipsm_frame_cpu`: the same for IPSM (and DPSM beside it), the casters refined
+//! against the paraboloid on the GPU.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
+use shadowmap::paraboloid::{
+    IpsmOptions, IpsmPlan, ParaboloidMap, Side, SubdivisionOptions, subdivide_triangles,
+};
 use shadowmap::{DpsmOptions, FitInput, Fitted, Shadow, Technique, fit};
-use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds, ShadowTransform};
+use shadowmap_frustum::{
+    Aabb, Camera, DepthBounds, Light, Projection, SceneBounds, ShadowTransform,
+};
 use shadowmap_rtw::{
     EyeSample, ImportanceMap, ImportanceOptions, RtwShadow, WarpMaps, WarpOptions,
 };
@@ -20,7 +26,9 @@ use shadowmap_wgpu::depth::{
 };
 use shadowmap_wgpu::refine::{GpuRefine, RefineOptions};
 use shadowmap_wgpu::rtw::{GpuRtw, RtwGBufferTextures};
-use shadowmap_wgpu::uniforms::{RtwShadowRaw, ToRaw, cascade_layers, paraboloid_layers};
+use shadowmap_wgpu::uniforms::{
+    ParaboloidLayerRaw, RtwShadowRaw, ToRaw, cascade_layers, paraboloid_layers,
+};
 
 fn camera() -> Camera {
     Camera::look_at(
@@ -304,6 +312,152 @@ fn rtw_frame_cpu(c: &mut Criterion) {
     g.finish();
 }
 
+/// One paraboloid frame's GPU objects: the refinement and the depth pass.
+struct ParaboloidFrame {
+    refine: GpuRefine,
+    pass: ShadowDepthPass,
+}
+
+impl ParaboloidFrame {
+    fn new(ctx: &GpuContext, casters: &[[Vec3; 3]], layers: u32) -> Result<Self, String> {
+        let options = RefineOptions::default().with_resolution(2048);
+        let desc = DepthPassDesc::new(DepthTechnique::Paraboloid, 2048).with_layers(layers);
+        ctx.scoped(|ctx| {
+            Ok(Self {
+                refine: GpuRefine::new(ctx, casters, &options)?,
+                pass: ShadowDepthPass::new(ctx, &desc)?,
+            })
+        })
+        .map_err(|e| e.to_string())
+    }
+
+    /// The frame's objects, with one frame run for real to report what it draws.
+    fn run_once(
+        ctx: &GpuContext,
+        casters: &[[Vec3; 3]],
+        name: &str,
+        map: &ParaboloidMap,
+    ) -> Result<Self, String> {
+        let mut frame = Self::new(ctx, casters, map.layers())?;
+        let (ok, commands) = frame.record(ctx, map);
+        ctx.queue.submit([commands]);
+        match frame.refine.read_stats(ctx) {
+            Ok(stats) if ok => eprintln!(
+                "ipsm_frame_cpu: {name}, {} side(s): {} casters -> {stats:?}",
+                map.layers(),
+                casters.len()
+            ),
+            other => eprintln!("ipsm_frame_cpu: {name} frame failed: {other:?}"),
+        }
+        Ok(frame)
+    }
+
+    /// Records the frame: the blocks packed, the casters refined, the indirect depth
+    /// pass (one layer per side).
+    fn record(&mut self, ctx: &GpuContext, map: &ParaboloidMap) -> (bool, wgpu::CommandBuffer) {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let layers: Vec<ParaboloidLayerRaw> = paraboloid_layers(map);
+        let uniforms = DepthUniforms::Paraboloid(&layers);
+        let recorded = self
+            .refine
+            .encode(ctx, &mut encoder, &uniforms)
+            .and_then(|()| {
+                self.pass
+                    .encode_refined(ctx, &mut encoder, &self.refine, &uniforms)
+            });
+        (recorded.is_ok(), encoder.finish())
+    }
+}
+
+/// CPU time to prepare and record one IPSM frame of the city block into a 2048² map:
+/// the plan fitted (`IpsmPlan::new`: truncated frustum, exact cone, cut), its blocks
+/// packed, the casters refined against the paraboloid on the GPU
+/// ([`GpuRefine::encode`]) and the depth pass drawn indirectly
+/// ([`ShadowDepthPass::encode_refined`]), the command buffer finished and the
+/// frame's uploads flushed (`submit([])`); the frame itself is not submitted (on a
+/// software adapter its execution is CPU rasterization). DPSM beside it: the same
+/// frame with two sides and a fixed map (no fit). The baseline, measured in the same
+/// run: the CPU subdivision of the casters for the IPSM side
+/// (`subdivide_paraboloid`), which the renderer did every frame before.
+fn ipsm_frame_cpu(c: &mut Criterion) {
+    let cam = camera();
+    // Behind and above the camera, outside the truncated frustum: one cut paraboloid.
+    let lamp = Light::Point {
+        position: Vec3::new(-30.0, 80.0, 120.0),
+        range: 600.0,
+    };
+    let bounds = DepthBounds {
+        min: 5.0,
+        max: 250.0,
+    };
+    let options = IpsmOptions::default();
+    let casters = city_casters();
+    let ipsm = IpsmPlan::new(&lamp, &cam, Some(bounds), &options).expect("ipsm");
+    let dpsm = ParaboloidMap::dual(
+        Vec3::new(-30.0, 80.0, 120.0),
+        Vec3::NEG_Y,
+        0.5,
+        600.0,
+        &Default::default(),
+    )
+    .expect("dpsm");
+    // The baseline in the same run: the CPU subdivision the GPU refinement replaces
+    // (what the renderer uploaded every frame before).
+    let sub = SubdivisionOptions::default().with_resolution(2048);
+    let mut pieces = Vec::new();
+    let n = subdivide_triangles(&ipsm.map, Side::Front, &casters, &sub, &mut pieces);
+    eprintln!("subdivide_paraboloid: {} -> {n:?} triangles", casters.len());
+    c.bench_function("subdivide_paraboloid/city_block_ipsm_2048", |b| {
+        b.iter(|| {
+            black_box(subdivide_triangles(
+                black_box(&ipsm.map),
+                Side::Front,
+                black_box(&casters),
+                &sub,
+                &mut pieces,
+            ))
+        });
+    });
+    let Ok(ctx) = GpuContext::new_headless() else {
+        eprintln!("ipsm_frame_cpu: no adapter, not measured");
+        return;
+    };
+    let frames = [("ipsm", ipsm.map), ("dpsm", dpsm)]
+        .into_iter()
+        .map(|(name, map)| ParaboloidFrame::run_once(&ctx, &casters, name, &map))
+        .collect::<Result<Vec<_>, _>>();
+    let mut frames = match frames {
+        Ok(frames) => frames,
+        Err(e) => {
+            eprintln!("ipsm_frame_cpu: setup failed: {e}");
+            return;
+        }
+    };
+    let [ipsm_frame, dpsm_frame] = &mut frames[..] else {
+        return;
+    };
+    let mut g = c.benchmark_group("ipsm_frame_cpu");
+    g.bench_function("city_block_2048_fit_and_gpu_refine", |b| {
+        b.iter(|| {
+            let plan = IpsmPlan::new(&lamp, &cam, Some(bounds), &options);
+            let recorded = match &plan {
+                Ok(plan) => black_box(ipsm_frame.record(&ctx, &plan.map)).0,
+                Err(_) => false,
+            };
+            ctx.queue.submit([]);
+            recorded
+        });
+    });
+    g.bench_function("dpsm_city_block_2048_gpu_refine", |b| {
+        b.iter(|| {
+            let recorded = black_box(dpsm_frame.record(&ctx, &dpsm));
+            ctx.queue.submit([]);
+            recorded.0
+        });
+    });
+    g.finish();
+}
+
 criterion_group!(benches, packing);
-criterion_group!(frame_cpu, rtw_frame_cpu);
+criterion_group!(frame_cpu, rtw_frame_cpu, ipsm_frame_cpu);
 criterion_main!(benches, frame_cpu);

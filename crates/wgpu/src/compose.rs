@@ -4,10 +4,14 @@
 //!
 //! - The scene shader (`render_scene.wgsl`) takes a lookup (`lookup_*.wgsl`) and a
 //!   filter (`filter_*.wgsl`): [`compose_scene_shader`].
-//! - RTW's depth pass (`depth_rtw.wgsl`), caster refinement (`rtw_refine.wgsl`) and
-//!   lookup (`lookup_rtw.wgsl`) take the one
-//!   warp-table sampler of `rtw_sample.wgsl` ([`with_rtw_sample`]), which has the
-//!   semantics of `shadowmap_rtw::sample_table`.
+//! - RTW's depth pass (`depth_rtw.wgsl`), lookup (`lookup_rtw.wgsl`), the caster
+//!   refinement (`refine.wgsl`) and the paraboloid depth pass and lookup (warped by
+//!   RTW over a paraboloid side) take the one warp-table sampler of `rtw_sample.wgsl`
+//!   ([`with_rtw_sample`]), which has the semantics of `shadowmap_rtw::sample_table`.
+//! - The paraboloid depth pass, lookup and the refinement take the one paraboloid
+//!   projection of `paraboloid_side.wgsl` (`ParaboloidMap::project`).
+//!
+//! [`expand`] fills every region a source has.
 //!
 //! Each placeholder is a stub with the real function's signature, so every file
 //! validates on its own as well as composed.
@@ -45,25 +49,42 @@ pub fn with_rtw_sample(host: &str) -> Result<String, BackendError> {
 /// RTW's depth pass with the table sampler composed in.
 ///
 /// # Errors
-/// As [`with_rtw_sample`].
+/// As [`expand`].
 pub fn depth_rtw() -> Result<String, BackendError> {
-    with_rtw_sample(shaders::DEPTH_RTW)
+    expand(shaders::DEPTH_RTW)
 }
 
-/// RTW's caster refinement with the table sampler composed in.
+/// The paraboloid depth pass with the projection and the table sampler composed in.
 ///
 /// # Errors
-/// As [`with_rtw_sample`].
-pub fn rtw_refine() -> Result<String, BackendError> {
-    with_rtw_sample(shaders::RTW_REFINE)
+/// As [`expand`].
+pub fn depth_paraboloid() -> Result<String, BackendError> {
+    expand(shaders::DEPTH_PARABOLOID)
+}
+
+/// The caster refinement with the table sampler and the paraboloid projection
+/// composed in.
+///
+/// # Errors
+/// As [`expand`].
+pub fn refine() -> Result<String, BackendError> {
+    expand(shaders::REFINE)
 }
 
 /// RTW's lookup with the table sampler composed in.
 ///
 /// # Errors
-/// As [`with_rtw_sample`].
+/// As [`expand`].
 pub fn lookup_rtw() -> Result<String, BackendError> {
-    with_rtw_sample(shaders::LOOKUP_RTW)
+    expand(shaders::LOOKUP_RTW)
+}
+
+/// The paraboloid lookup with the projection and the table sampler composed in.
+///
+/// # Errors
+/// As [`expand`].
+pub fn lookup_paraboloid() -> Result<String, BackendError> {
+    expand(shaders::LOOKUP_PARABOLOID)
 }
 
 /// Replaces the `@compose lookup` and `@compose filter` regions of
@@ -87,11 +108,10 @@ macro_rules! combos {
 }
 
 /// Every source the backend composes at run time: each lookup with each filter,
-/// named `render_scene+LOOKUP+FILTER` (the RTW lookup with its table sampler), then
-/// RTW's depth pass, `depth_rtw+rtw_sample`, and its caster refinement,
-/// `rtw_refine+rtw_sample`; each with the composition's own result,
-/// so a failing one is reported by name rather than dropped (the naga test validates
-/// them all).
+/// named `render_scene+LOOKUP+FILTER` (lookups with their shared functions), then
+/// the depth passes and the refinement with theirs (`depth_rtw+`, `depth_paraboloid+`,
+/// `refine+`); each with the composition's own result, so a failing one is reported
+/// by name rather than dropped (the naga test validates them all).
 #[must_use]
 pub fn composed_shaders() -> Vec<(&'static str, Result<String, BackendError>)> {
     let all = combos![
@@ -121,21 +141,29 @@ pub fn composed_shaders() -> Vec<(&'static str, Result<String, BackendError>)> {
         .map(|(name, l, f)| (*name, expand(l).and_then(|l| compose_scene_shader(&l, f))))
         .collect();
     out.push(("depth_rtw+rtw_sample", depth_rtw()));
-    out.push(("rtw_refine+rtw_sample", rtw_refine()));
+    out.push((
+        "depth_paraboloid+paraboloid_side+rtw_sample",
+        depth_paraboloid(),
+    ));
+    out.push(("refine+rtw_sample+paraboloid_side", refine()));
     out
 }
 
-/// `source` with every shared function it asks for composed in (today the RTW
-/// table sampler); unchanged when it has no placeholder.
+/// `source` with every shared function it asks for composed in: the RTW table
+/// sampler (`@compose rtw_sample`) and the paraboloid projection (`@compose
+/// paraboloid_side`); unchanged when it has no placeholder.
 ///
 /// # Errors
 /// As [`with_rtw_sample`].
 pub fn expand(source: &str) -> Result<String, BackendError> {
-    if source.contains("// @compose rtw_sample begin") {
-        with_rtw_sample(source)
-    } else {
-        Ok(source.to_owned())
+    let mut out = source.to_owned();
+    if out.contains("// @compose rtw_sample begin") {
+        out = with_rtw_sample(&out)?;
     }
+    if out.contains("// @compose paraboloid_side begin") {
+        out = replace_region(&out, "paraboloid_side", shaders::PARABOLOID_SIDE)?;
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -156,12 +184,27 @@ mod tests {
         for source in [
             depth_rtw().unwrap(),
             lookup_rtw().unwrap(),
-            rtw_refine().unwrap(),
+            refine().unwrap(),
+            depth_paraboloid().unwrap(),
+            lookup_paraboloid().unwrap(),
         ] {
             assert_eq!(source.matches("fn rtw_sample(").count(), 1);
             assert!(source.contains("rtw_tables[offset + i]"));
             assert!(!source.contains("// @compose"));
             assert_eq!(source.matches("var<storage, read> rtw_tables").count(), 1);
+        }
+    }
+
+    #[test]
+    fn paraboloid_hosts_get_the_real_projection_once() {
+        for source in [
+            depth_paraboloid().unwrap(),
+            lookup_paraboloid().unwrap(),
+            refine().unwrap(),
+        ] {
+            assert_eq!(source.matches("fn paraboloid_side(").count(), 1);
+            assert!(source.contains("(x * x + d.y * d.y) / (1.0 - s)"));
+            assert!(!source.contains("// @compose"));
         }
     }
 }

@@ -273,6 +273,66 @@ impl GpuContext {
 /// The environment variable that turns a missing adapter into a test failure.
 pub const REQUIRE_GPU_ENV: &str = "SHADOWMAP_REQUIRE_GPU";
 
+/// A pipeline drawing [`MeshBuffers`](crate::depth::MeshBuffers) triangle lists, both faces, with `vs_main`
+/// and (given colour targets, possibly none) `fs_main` of `module`; `layout` `None`:
+/// derived from the shader.
+pub(crate) fn mesh_pipeline(
+    device: &wgpu::Device,
+    (label, layout, module): (&str, Option<&wgpu::PipelineLayout>, &wgpu::ShaderModule),
+    depth_stencil: wgpu::DepthStencilState,
+    targets: Option<&[Option<wgpu::ColorTargetState>]>,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout,
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(crate::depth::MeshBuffers::layout())],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(depth_stencil),
+        multisample: Default::default(),
+        fragment: targets.map(|targets| wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// A one-layer, one-mip 2-D texture (render targets, G-buffers, read-back images).
+pub(crate) fn texture_2d(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
 /// The context for a GPU test: `Some` when an adapter opens; `None` with a one-line
 /// notice on stderr when none does; a panic (test failure) when none does and
 /// `SHADOWMAP_REQUIRE_GPU=1` is set, so CI cannot silently skip.

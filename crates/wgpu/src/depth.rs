@@ -1,5 +1,8 @@
 //! Shadow depth passes: matrix techniques (uniform, cascades, LiSPSM, XPSM, TSM),
-//! paraboloid (front and back layers), and RTW (warped vertices).
+//! paraboloid (front and back layers, optionally warped by RTW tables per side), and
+//! RTW (warped vertices over an orthographic or perspective base). The paraboloid and
+//! RTW passes draw casters subdivided on the CPU ([`ShadowDepthPass::encode`]) or
+//! refined on the GPU and drawn indirectly ([`ShadowDepthPass::encode_refined`]).
 //!
 //! One [`ShadowDepthPass`] owns a `Depth32Float` 2-D array texture (one layer per
 //! cascade or paraboloid side), its pipeline, and a uniform buffer with one block per
@@ -128,6 +131,14 @@ pub enum DepthUniforms<'a> {
     Matrix(&'a [MatrixShadowRaw]),
     /// One block per side ([`crate::uniforms::paraboloid_layers`]).
     Paraboloid(&'a [ParaboloidLayerRaw]),
+    /// One block per side whose `warp` places the side's RTW tables in `tables`
+    /// (RTW over the paraboloid, [`crate::uniforms::warped_paraboloid`]).
+    WarpedParaboloid {
+        /// One block per side.
+        layers: &'a [ParaboloidLayerRaw],
+        /// Every side's tables.
+        tables: &'a [f32],
+    },
     /// The base projection and the tables (`u` then `v`,
     /// [`RtwShadowRaw::tables`]); one layer.
     Rtw {
@@ -153,7 +164,7 @@ impl DepthUniforms<'_> {
     fn technique(&self) -> DepthTechnique {
         match self {
             Self::Matrix(_) => DepthTechnique::Matrix,
-            Self::Paraboloid(_) => DepthTechnique::Paraboloid,
+            Self::Paraboloid(_) | Self::WarpedParaboloid { .. } => DepthTechnique::Paraboloid,
             Self::Rtw { .. } | Self::RtwGpuTables { .. } => DepthTechnique::Rtw,
         }
     }
@@ -161,7 +172,7 @@ impl DepthUniforms<'_> {
     fn layer_count(&self) -> usize {
         match self {
             Self::Matrix(m) => m.len(),
-            Self::Paraboloid(p) => p.len(),
+            Self::Paraboloid(p) | Self::WarpedParaboloid { layers: p, .. } => p.len(),
             Self::Rtw { .. } | Self::RtwGpuTables { .. } => 1,
         }
     }
@@ -171,7 +182,7 @@ impl DepthUniforms<'_> {
     fn layer_bytes(&self, layer: usize, resolution: u32) -> Vec<u8> {
         match self {
             Self::Matrix(m) => bytemuck::bytes_of(&m[layer]).to_vec(),
-            Self::Paraboloid(p) => {
+            Self::Paraboloid(p) | Self::WarpedParaboloid { layers: p, .. } => {
                 let mut raw = p[layer];
                 raw.side[1] = resolution as f32;
                 bytemuck::bytes_of(&raw).to_vec()
@@ -284,6 +295,7 @@ pub struct ShadowDepthPass {
     layout: wgpu::BindGroupLayout,
     uniforms: wgpu::Buffer,
     slot: u64,
+    block: u64,
     tables: Option<wgpu::Buffer>,
     bind_group: wgpu::BindGroup,
     texture: wgpu::Texture,
@@ -339,7 +351,8 @@ impl ShadowDepthPass {
             },
             count: None,
         }];
-        if desc.technique == DepthTechnique::Rtw {
+        let warped = desc.technique != DepthTechnique::Matrix;
+        if warped {
             entries.push(storage_entry(1, wgpu::ShaderStages::VERTEX));
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -353,7 +366,7 @@ impl ShadowDepthPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let tables = (desc.technique == DepthTechnique::Rtw).then(|| table_buffer(device, 1));
+        let tables = warped.then(|| table_buffer(device, 1));
         let bind_group = make_bind_group(device, &layout, &uniforms, block, tables.as_ref());
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadowmap depth"),
@@ -393,6 +406,7 @@ impl ShadowDepthPass {
             layout,
             uniforms,
             slot,
+            block,
             tables,
             bind_group,
             texture,
@@ -447,14 +461,16 @@ impl ShadowDepthPass {
         Ok(())
     }
 
-    /// [`ShadowDepthPass::encode`] for casters refined on the GPU: uploads the RTW
-    /// uniforms as `encode` does and draws the refined triangles of `refined` with
-    /// `draw_indirect` (the count the refinement wrote). Record it after
-    /// [`crate::refine::GpuRefine::encode`], in the same or a later submission.
+    /// [`ShadowDepthPass::encode`] for casters refined on the GPU: uploads the
+    /// uniforms as `encode` does and draws each layer's refined triangles of
+    /// `refined` with `draw_indirect` (the counts the refinement wrote). Record it
+    /// after [`crate::refine::GpuRefine::encode`] with the same uniforms, in the same
+    /// or a later submission.
     ///
     /// # Errors
-    /// As [`ShadowDepthPass::encode`]; also [`BackendError::InvalidInput`] for a pass
-    /// that is not RTW's.
+    /// As [`ShadowDepthPass::encode`]; also [`BackendError::InvalidInput`] for a
+    /// matrix pass (nothing to refine) or a refinement last recorded for another
+    /// layer count.
     pub fn encode_refined(
         &mut self,
         ctx: &GpuContext,
@@ -462,16 +478,32 @@ impl ShadowDepthPass {
         refined: &crate::refine::GpuRefine,
         uniforms: &DepthUniforms<'_>,
     ) -> Result<(), BackendError> {
-        if self.desc.technique != DepthTechnique::Rtw {
+        if self.desc.technique == DepthTechnique::Matrix {
             return Err(BackendError::InvalidInput(
-                "refined casters are drawn by the RTW pass",
+                "refined casters are drawn by the RTW and paraboloid passes",
+            ));
+        }
+        if refined.layers() != self.desc.layers {
+            return Err(BackendError::InvalidInput(
+                "the refinement was recorded for another layer count",
             ));
         }
         self.upload(ctx, encoder, uniforms)?;
-        let mut pass = self.begin_layer(encoder, 0);
-        pass.set_vertex_buffer(0, refined.vertices().slice(..));
-        pass.draw_indirect(refined.draw_buffer(), 0);
+        self.record_refined(encoder, refined);
         Ok(())
+    }
+
+    /// Records the passes of the refined casters with the uniforms already written.
+    pub fn record_refined(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        refined: &crate::refine::GpuRefine,
+    ) {
+        for layer in 0..self.layer_views.len() {
+            let mut pass = self.begin_layer(encoder, layer);
+            pass.set_vertex_buffer(0, refined.vertices().slice(..));
+            pass.draw_indirect(refined.draw_buffer(), crate::refine::draw_offset(layer));
+        }
     }
 
     /// Checks `uniforms` against the pass, queues the layers' blocks and brings the
@@ -518,6 +550,21 @@ impl ShadowDepthPass {
                 let buffer = self.rtw_table_buffer(ctx, bytes);
                 encoder.copy_buffer_to_buffer(tables, 0, buffer, 0, bytes);
             }
+            DepthUniforms::WarpedParaboloid { layers, tables } => {
+                let needed = layers
+                    .iter()
+                    .map(|l| warp_table_end(&l.warp))
+                    .max()
+                    .unwrap_or(0);
+                if tables.len() < needed.max(1) {
+                    return Err(BackendError::InvalidInput(
+                        "paraboloid warp tables shorter than their layers' offsets",
+                    ));
+                }
+                let bytes: &[u8] = bytemuck::cast_slice(tables);
+                let buffer = self.rtw_table_buffer(ctx, bytes.len() as u64);
+                ctx.queue.write_buffer(buffer, 0, bytes);
+            }
             DepthUniforms::Matrix(_) | DepthUniforms::Paraboloid(_) => {}
         }
         for layer in 0..layers {
@@ -539,7 +586,7 @@ impl ShadowDepthPass {
                 &ctx.device,
                 &self.layout,
                 &self.uniforms,
-                size_of::<RtwShadowRaw>() as u64,
+                self.block,
                 Some(&buffer),
             );
             self.tables = Some(buffer);
@@ -605,6 +652,13 @@ pub(crate) fn rtw_table_texels(raw: &RtwShadowRaw) -> usize {
     (raw.sizes[0] as usize).saturating_add(raw.sizes[1] as usize)
 }
 
+/// One past the last texel a paraboloid side's warp (`u` offset, `u` texels, `v`
+/// offset, `v` texels) reads.
+pub(crate) fn warp_table_end(warp: &[u32; 4]) -> usize {
+    let end = |offset: u32, texels: u32| (offset as usize).saturating_add(texels as usize);
+    end(warp[0], warp[1]).max(end(warp[2], warp[3]))
+}
+
 /// The depth pipeline of a pass: the technique's vertex shader (RTW's with its table
 /// sampler composed in), a fragment stage only where the paraboloid clips, the
 /// depth test and rasterizer bias of `desc`.
@@ -620,7 +674,7 @@ fn create_pipeline(
             false,
         ),
         DepthTechnique::Paraboloid => (
-            shaders::DEPTH_PARABOLOID.to_owned(),
+            compose::depth_paraboloid()?,
             "shadowmap depth paraboloid",
             true,
         ),
@@ -635,33 +689,13 @@ fn create_pipeline(
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
-    Ok(
-        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(MeshBuffers::layout())],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(depth_state(desc.reversed_z, desc.bias)),
-            multisample: Default::default(),
-            fragment: fragment.then(|| wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[],
-            }),
-            multiview_mask: None,
-            cache: None,
-        }),
-    )
+    let targets = fragment.then_some(&[][..]);
+    Ok(crate::context::mesh_pipeline(
+        device,
+        (label, Some(&pipeline_layout), &module),
+        depth_state(desc.reversed_z, desc.bias),
+        targets,
+    ))
 }
 
 /// A [`DEPTH_FORMAT`] attachment that keeps the nearer depth (`Less`, or `Greater`

@@ -13,13 +13,14 @@
 //! | [`context`] | [`GpuContext`]: headless device, error scopes ([`GpuContext::scoped`]), readback ([`GpuContext::read_buffer`], [`GpuContext::read_texture`]), test gating |
 //! | [`compose`] | WGSL composition: lookups and filters into the scene shader, the RTW table sampler into its depth pass and lookup |
 //! | [`uniforms`] | `#[repr(C)]` blocks built by [`uniforms::ToRaw`] |
-//! | [`depth`] | [`depth::ShadowDepthPass`]: matrix / paraboloid / RTW depth passes, caster subdivision for RTW |
+//! | [`depth`] | [`depth::ShadowDepthPass`]: matrix / paraboloid / RTW depth passes (RTW over an orthographic or perspective base, paraboloid sides optionally warped) |
 //! | [`render`] | [`render::HeadlessRenderer`]: scene pass with a lookup and a filter composed in, PNGs, shadow masks |
 //! | [`shadow`] | [`render::HeadlessRenderer::render_shadow`]: a fitted `shadowmap::Shadow` to the renderer, the one match from fitted result to lookup and depth pass |
 //! | [`profile`] | [`profile::GpuProfiler`]: GPU time per pass from timestamp queries |
 //! | [`reduce`] | depth min/max reduction (SDSM, IPSM depth bounds) |
 //! | [`rtw`] | [`rtw::GpuRtw`]: importance, blur, warp tables on the GPU |
-//! | [`refine`] | [`refine::GpuRefine`]: RTW caster subdivision as a compute pass writing an indirect draw |
+//! | [`gbuffer`] | [`gbuffer::RtwGBufferPass`]: RTW's eye G-buffer rendered on the GPU |
+//! | [`refine`] | [`refine::GpuRefine`]: caster refinement for RTW and the paraboloid maps as a compute pass writing indirect draws |
 //! | [`volume`] | [`volume::VolumeRenderer`]: stencil shadow volumes (z-pass, z-fail with caps), the exact mask; [`volume::misclassification`] of any technique against it; [`volume::ProjectiveRenderer`]: projective shadows |
 //! | [`shaders`] | every WGSL source, embedded |
 //!
@@ -67,9 +68,10 @@
 //!   pass writes its map resolution into one spare lane (`ParaboloidLayerRaw::side.y`,
 //!   `RtwShadowRaw::sizes.w`) for the subpixel snap below.
 //! - **Bind groups.** Depth passes: group 0 = binding 0 the layer's block (one
-//!   256-byte-aligned slot per layer, dynamic offset), binding 1 the RTW tables.
-//!   Scene pass: group 0 the frame (`FrameRaw`), group 1 the lookup (binding 0 the
-//!   technique's block, binding 1 the RTW tables), group 2 the maps (binding 0 the
+//!   256-byte-aligned slot per layer, dynamic offset), binding 1 the warp tables
+//!   (RTW and paraboloid passes). Scene pass: group 0 the frame (`FrameRaw`), group 1
+//!   the lookup (binding 0 the technique's block, binding 1 the warp tables of the
+//!   RTW and paraboloid lookups), group 2 the maps (binding 0 the
 //!   `texture_depth_2d_array`, 1 the comparison sampler, 2 the VSM moments). Compute
 //!   passes own group 0 (see [`reduce`] and [`rtw`]).
 //! - **Depth maps.** `Depth32Float` 2-D arrays, one layer per cascade or paraboloid
@@ -88,10 +90,16 @@
 //!   `(i + 0.5) / N`, `T[0] = T[N-1] = 0`, sampled by hand with the texel-centre
 //!   linear, clamp-to-edge semantics of `shadowmap_rtw::forward_warp`. Written by
 //!   the CPU ([`uniforms::RtwShadowRaw::tables`]) or by [`rtw::GpuRtw`] (fed to the
-//!   depth pass by [`rtw::GpuRtw::depth_uniforms`]). Casters are subdivided since
-//!   only vertices are warped: on the GPU every frame ([`refine::GpuRefine`], drawn
-//!   by [`depth::ShadowDepthPass::encode_refined`]) or on the CPU, the reference
-//!   ([`depth::subdivide_for_rtw`]); both follow one split rule.
+//!   depth pass by [`rtw::GpuRtw::depth_uniforms`]). RTW over the sides of a
+//!   paraboloid (`point_rtw`) keeps every side's tables in one buffer, each side's
+//!   offsets in its block ([`uniforms::warped_paraboloid`]).
+//! - **Caster refinement.** RTW warps and the paraboloid bends only vertices, so
+//!   casters are subdivided: on the GPU every frame ([`refine::GpuRefine`], drawn by
+//!   [`depth::ShadowDepthPass::encode_refined`]; the headless renderer's path) or on
+//!   the CPU, the reference ([`depth::subdivide_for_rtw`],
+//!   `shadowmap_paraboloid::subdivide_triangles`); each pair follows one split rule
+//!   (`RtwSubdivision::split_rule`, `SubdivisionOptions::split_rule`). Casters the
+//!   base cannot map (behind a perspective light) are dropped both ways.
 //! - **Subpixel snap.** The paraboloid and RTW vertex shaders snap positions to the
 //!   1/256-pixel grid of the rasterizer: their maps compress, so casters become
 //!   slivers with depth slopes near 1 per texel, and rasterizers differ in whether
@@ -113,24 +121,54 @@
 //! SHADOWMAP_REQUIRE_GPU=1 cargo test -p shadowmap-wgpu
 //! ```
 //!
+//! # Portability of the compute passes
+//!
+//! The RTW analysis failed on an NVIDIA H100 (identity tables for a 64x48 map with
+//! importance near `f32::MAX`): the tables shader divided by a peak above 2^126,
+//! outside the range where WGSL guarantees `x / y`; it now scales by exponent bits.
+//! The other suspects were audited ([`rtw`], "Memory, barriers, subgroups,
+//! reduction order"): every workgroup variable is written before it is read (the
+//! pipelines run without wgpu's zeroing, so the llvmpipe tests see what a driver
+//! that leaves it uninitialized would give); the density history, read times a zero
+//! weight on a first build (`0 * NaN` is NaN), is now read only when there is
+//! history (a test fills it with NaN first); barriers are in uniform control flow;
+//! no subgroup operation is used; the one floating-point sum is a fixed-order scan;
+//! maps and G-buffers that are not multiples of the workgroups are tested. The
+//! refinement ([`refine`]) uses no workgroup memory and meets other invocations only
+//! in integer atomics.
+//!
 //! # GPU timings
 //!
-//! [`profile::GpuProfiler`] times passes on the GPU with timestamp queries, and
-//! [`render::HeadlessRenderer::render_profiled`] records the depth, VSM and scene
-//! passes of a frame with it. `cargo run --release -p shadowmap-wgpu --example
-//! gpu_frame [-- --json]` renders the city block at 1920x1080 with a 2048² budget per
-//! technique and prints the fit's CPU time, the render call's wall time and each
-//! pass's GPU time. No hardware GPU table is recorded here: none was lent to this
-//! task, and llvmpipe's timestamps measure CPU rasterization, not a GPU.
+//! [`profile::GpuProfiler`] measures each scope's CPU recording time and, on a
+//! device with `TIMESTAMP_QUERY`, its GPU time;
+//! [`render::HeadlessRenderer::render_profiled`] records a frame's `refine`,
+//! `depth`, `vsm` and `scene` passes with it. `cargo run --release -p shadowmap-wgpu
+//! --example gpu_frame [-- --json]` renders the city block at 1920x1080 with a 2048²
+//! budget for every technique (uniform, cascades, LiSPSM, XPSM, TSM, RTW with CPU
+//! tables, `rtw_gpu` with its analysis on the GPU: G-buffer, importance, tables;
+//! spot, DPSM, IPSM, cube maps, RTW over the spot fit and over the paraboloid),
+//! prints CPU ms and GPU ms per pass (CPU times only, and says so, without the
+//! timestamp features) and then the backend's three targets:
 //!
-//! Hardware GPU figures of the benches were not recorded either. `cargo bench -p
-//! shadowmap-wgpu --bench frame` and `--bench compute` measure the CPU side (uniform
-//! packing, command encoding, caster subdivision) and, where an adapter opens, GPU
-//! round trips; on this machine the adapter is llvmpipe, so any GPU-side figure is
-//! a software-adapter figure (CPU rasterization), not a GPU timing. `--bench frame`
-//! on a shared 2-core machine, release profile, adapter llvmpipe (LLVM 15, 256
-//! bits); the `encode/*` rows are CPU time to record commands (the adapter only
-//! matters through wgpu's validation):
+//! ```text
+//! RTW analysis: importance + tables, GPU ms                           <= 0.1 ms
+//! RTW frame: importance + tables + refine + depth / uniform's depth   <= 2
+//! IPSM (one cut paraboloid: refine + depth) / DPSM (two sides)        <= 0.6
+//! ```
+//!
+//! No hardware GPU was lent to this task, so these are not measured here. llvmpipe
+//! exposes timestamps, but they time CPU rasterization and compute emulation: on it
+//! (shared 2-core machine) the three figures read 5.9 ms, 54 and 0.80, which say
+//! nothing about a GPU (the refinement's compute alone takes 260 ms there).
+//!
+//! `cargo bench -p shadowmap-wgpu --bench frame` and `--bench compute` measure the
+//! CPU side (uniform packing, command encoding, caster subdivision) and, where an
+//! adapter opens, GPU round trips; on this machine the adapter is llvmpipe, so any
+//! GPU-side figure is a software-adapter figure (CPU rasterization), not a GPU
+//! timing. `--bench frame` on a shared 2-core machine (load average about 5),
+//! release profile, adapter llvmpipe (LLVM 15, 256 bits); the `encode/*` and
+//! `*_frame_cpu` rows are CPU time to record commands (the adapter only matters
+//! through wgpu's validation):
 //!
 //! ```text
 //! pack/uniform, pack/xpsm (to_raw)                 16 ns
@@ -138,13 +176,19 @@
 //! pack/cascades_layers_4                           60 ns
 //! pack/paraboloid_layers                           47 ns
 //! pack/rtw_256 (block + 512 table floats)          67 ns
-//! subdivide_rtw/city_block_256_cells_2048          64 ms  (5264 -> 722 512 triangles)
 //! encode/cascades_4_depth_passes                   25 us
 //! encode/rtw_depth_pass_256_cell_tables            23 us
-//! rtw_frame_cpu/city_block_2048_tables_256_gpu_refine  51 us  (same run as a 66 ms
-//!     subdivide_rtw: tables built, casters refined and the depth pass drawn
-//!     indirectly on the GPU, 5264 -> 696 144 triangles there; 1/1300 of the CPU
-//!     subdivision it replaces)
+//!
+//! same run (load average 4.7):
+//! subdivide_rtw/city_block_256_cells_2048         108 ms  (CPU: 5264 -> 722 512 triangles)
+//! rtw_frame_cpu/city_block_2048_tables_256_gpu_refine  64 us  (tables built,
+//!     casters refined and the depth pass drawn indirectly on the GPU, 5264 ->
+//!     696 144 triangles there; 1/1700 of the CPU subdivision it replaces)
+//! subdivide_paraboloid/city_block_ipsm_2048       4.9 ms  (CPU: 5264 -> 41 735)
+//! ipsm_frame_cpu/city_block_2048_fit_and_gpu_refine    62 us  (IPSM plan fitted,
+//!     casters refined against the paraboloid on the GPU, 41 735 triangles there,
+//!     depth pass drawn indirectly; 1/79 of the CPU subdivision alone)
+//! ipsm_frame_cpu/dpsm_city_block_2048_gpu_refine       67 us  (two sides, 76 169)
 //! ```
 
 pub mod compose;
@@ -159,6 +203,7 @@ pub mod shadow;
 pub mod uniforms;
 
 // --- compute passes: depth reduction, RTW pipeline (another author) ---
+pub mod gbuffer;
 pub mod reduce;
 pub mod refine;
 pub mod rtw;
@@ -174,8 +219,13 @@ pub mod shaders {
     // --- depth passes, lookups, filters, renderer (depth_*, lookup_*, filter_*, render_*) ---
     /// Depth pass of the matrix techniques (uniform, cascades, LiSPSM, XPSM, TSM).
     pub const DEPTH_MATRIX: &str = include_str!("../shaders/depth_matrix.wgsl");
-    /// Depth pass of a paraboloid map (one side per layer, hemisphere clipped).
+    /// Depth pass of a paraboloid map (one side per layer, hemisphere clipped, warp
+    /// tables optional); its shared functions are placeholders until composed
+    /// ([`crate::compose::depth_paraboloid`]).
     pub const DEPTH_PARABOLOID: &str = include_str!("../shaders/depth_paraboloid.wgsl");
+    /// The paraboloid projection, composed into the paraboloid depth pass, lookup and
+    /// the caster refinement.
+    pub const PARABOLOID_SIDE: &str = include_str!("../shaders/paraboloid_side.wgsl");
     /// Depth pass of RTW (base projection, then the warp tables per axis); its
     /// table sampler is a placeholder until composed ([`crate::compose::depth_rtw`]).
     pub const DEPTH_RTW: &str = include_str!("../shaders/depth_rtw.wgsl");
@@ -183,7 +233,9 @@ pub mod shaders {
     pub const LOOKUP_MATRIX: &str = include_str!("../shaders/lookup_matrix.wgsl");
     /// Lookup of cascades: selection by view depth with the blend band, or by projection.
     pub const LOOKUP_CASCADES: &str = include_str!("../shaders/lookup_cascades.wgsl");
-    /// Lookup of a paraboloid map (front/back side, cut).
+    /// Lookup of a paraboloid map (front/back side, cut, warp tables optional); its
+    /// shared functions are placeholders until composed
+    /// ([`crate::compose::lookup_paraboloid`]).
     pub const LOOKUP_PARABOLOID: &str = include_str!("../shaders/lookup_paraboloid.wgsl");
     /// Lookup of RTW (base projection, warp tables); its table sampler is a
     /// placeholder until composed ([`crate::compose::lookup_rtw`]).
@@ -210,11 +262,14 @@ pub mod shaders {
     pub const REDUCE_DEPTH: &str = include_str!("../shaders/reduce_depth.wgsl");
     /// RTW importance splat from an eye-space G-buffer and collapse to 1-D maxima.
     pub const RTW_IMPORTANCE: &str = include_str!("../shaders/rtw_importance.wgsl");
+    /// RTW's eye-space G-buffer rendered from the camera (position, distance, normal).
+    pub const RTW_GBUFFER: &str = include_str!("../shaders/rtw_gbuffer.wgsl");
     /// RTW per-axis blur, normalization, temporal smoothing, floor and warp table.
     pub const RTW_WARP: &str = include_str!("../shaders/rtw_warp.wgsl");
-    /// RTW caster refinement (count, choose, emit) writing an indirect draw; its
-    /// table sampler is a placeholder until composed ([`crate::compose::rtw_refine`]).
-    pub const RTW_REFINE: &str = include_str!("../shaders/rtw_refine.wgsl");
+    /// Caster refinement (count, choose, emit) for RTW and paraboloid maps, writing
+    /// indirect draws; its shared functions are placeholders until composed
+    /// ([`crate::compose::refine`]).
+    pub const REFINE: &str = include_str!("../shaders/refine.wgsl");
 
     // --- shadow volumes, projective shadows (volume_*, projective_*) ---
     /// Stencil shadow volumes: surfaces, two-sided stencil count, classification.

@@ -1,13 +1,15 @@
-//! GPU time per pass from timestamp queries.
+//! GPU time per pass from timestamp queries, and the CPU time of recording it.
 //!
 //! A [`GpuProfiler`] writes a timestamp before and after each scope it wraps
 //! ([`GpuProfiler::scope`]), resolves them at the end of the frame
 //! ([`GpuProfiler::resolve`]) and reads them back as milliseconds
-//! ([`GpuProfiler::read`]). It needs [`wgpu::Features::TIMESTAMP_QUERY`] and
+//! ([`GpuProfiler::read`]). It also measures the CPU time the scope's recording took
+//! (encoding, uploads queued, validation). GPU times need
+//! [`wgpu::Features::TIMESTAMP_QUERY`] and
 //! [`wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS`] ([`GpuProfiler::FEATURES`];
 //! open the device with [`GpuContext::new_headless_with_features`]); on a device
-//! without them it records nothing and [`GpuProfiler::unsupported`] says why, so the
-//! caller can print CPU times only.
+//! without them every scope reads with CPU time only and
+//! [`GpuProfiler::unsupported`] says why.
 //!
 //! ```no_run
 //! use shadowmap_wgpu::GpuContext;
@@ -20,10 +22,12 @@
 //! profiler.resolve(&mut encoder);
 //! ctx.queue.submit([encoder.finish()]);
 //! for pass in profiler.read(&ctx)? {
-//!     println!("{}: {:.3} ms", pass.label, pass.gpu_ms);
+//!     println!("{}: CPU {:.3} ms, GPU {:?} ms", pass.label, pass.cpu_ms, pass.gpu_ms);
 //! }
 //! # Ok::<(), shadowmap_wgpu::BackendError>(())
 //! ```
+
+use std::time::Instant;
 
 use crate::{BackendError, GpuContext};
 
@@ -32,8 +36,11 @@ use crate::{BackendError, GpuContext};
 pub struct PassTime {
     /// The scope's label.
     pub label: String,
-    /// GPU time between its begin and end timestamps, in milliseconds.
-    pub gpu_ms: f64,
+    /// CPU time of recording the scope, in milliseconds.
+    pub cpu_ms: f64,
+    /// GPU time between its begin and end timestamps, in milliseconds; `None`
+    /// without timestamp support or past the profiler's scopes.
+    pub gpu_ms: Option<f64>,
 }
 
 /// The query set and its resolve buffer.
@@ -48,7 +55,8 @@ struct Queries {
 #[derive(Debug)]
 pub struct GpuProfiler {
     queries: Option<Queries>,
-    labels: Vec<String>,
+    /// This frame's scopes: label, CPU ms, whether it has timestamps.
+    scopes: Vec<(String, f64, bool)>,
     period_ns: f64,
 }
 
@@ -81,7 +89,7 @@ impl GpuProfiler {
         });
         Self {
             queries,
-            labels: Vec::new(),
+            scopes: Vec::new(),
             period_ns: f64::from(ctx.queue.get_timestamp_period()),
         }
     }
@@ -95,54 +103,69 @@ impl GpuProfiler {
         }
     }
 
-    /// Runs `record` between two timestamps labelled `label`. Without support, or
-    /// once the frame's scopes are used up, it only runs `record`.
+    /// Runs `record` between two timestamps labelled `label` and measures its CPU
+    /// time. Without support, or once the frame's timestamps are used up, the scope
+    /// gets CPU time only. Scopes may span several encoders of one frame (resolve in
+    /// the last one, submitted last).
     pub fn scope<T>(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         label: &str,
         record: impl FnOnce(&mut wgpu::CommandEncoder) -> T,
     ) -> T {
-        let index = self.labels.len() as u32;
-        let Some(q) = self.queries.as_ref().filter(|q| index < q.capacity) else {
-            return record(encoder);
-        };
-        encoder.write_timestamp(&q.set, 2 * index);
+        let index = self.timed_scopes();
+        let queries = self.queries.as_ref().filter(|q| index < q.capacity);
+        if let Some(q) = queries {
+            encoder.write_timestamp(&q.set, 2 * index);
+        }
+        let start = Instant::now();
         let out = record(encoder);
-        encoder.write_timestamp(&q.set, 2 * index + 1);
-        self.labels.push(label.to_owned());
+        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+        if let Some(q) = queries {
+            encoder.write_timestamp(&q.set, 2 * index + 1);
+        }
+        self.scopes
+            .push((label.to_owned(), cpu_ms, queries.is_some()));
         out
+    }
+
+    /// Scopes of this frame with timestamps.
+    fn timed_scopes(&self) -> u32 {
+        self.scopes.iter().filter(|s| s.2).count() as u32
     }
 
     /// Records the resolve of this frame's timestamps; call once, after the last
     /// scope, before submitting.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        if let Some(q) = self.queries.as_ref().filter(|_| !self.labels.is_empty()) {
-            let used = 2 * self.labels.len() as u32;
+        let used = 2 * self.timed_scopes();
+        if let Some(q) = self.queries.as_ref().filter(|_| used > 0) {
             encoder.resolve_query_set(&q.set, 0..used, &q.resolve, 0);
         }
     }
 
-    /// The GPU time of each scope of the submitted frame, in order, and starts a new
-    /// frame. Empty without support. Waits for the GPU.
+    /// Each scope of the submitted frame, in order, with its CPU time and (with
+    /// timestamps) its GPU time, and starts a new frame. Waits for the GPU.
     ///
     /// # Errors
     /// [`BackendError::Readback`] if mapping fails.
     pub fn read(&mut self, ctx: &GpuContext) -> Result<Vec<PassTime>, BackendError> {
-        let labels = std::mem::take(&mut self.labels);
-        let Some(q) = &self.queries else {
-            return Ok(Vec::new());
+        let scopes = std::mem::take(&mut self.scopes);
+        let ticks: Vec<u64> = match &self.queries {
+            Some(q) if scopes.iter().any(|s| s.2) => {
+                bytemuck::pod_collect_to_vec(&ctx.read_buffer(&q.resolve)?)
+            }
+            _ => Vec::new(),
         };
-        if labels.is_empty() {
-            return Ok(Vec::new());
-        }
-        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&ctx.read_buffer(&q.resolve)?);
-        Ok(labels
+        let mut pairs = ticks.chunks_exact(2);
+        Ok(scopes
             .into_iter()
-            .zip(ticks.chunks_exact(2))
-            .map(|(label, pair)| PassTime {
+            .map(|(label, cpu_ms, timed)| PassTime {
                 label,
-                gpu_ms: pair[1].saturating_sub(pair[0]) as f64 * self.period_ns * 1e-6,
+                cpu_ms,
+                gpu_ms: timed
+                    .then(|| pairs.next())
+                    .flatten()
+                    .map(|pair| pair[1].saturating_sub(pair[0]) as f64 * self.period_ns * 1e-6),
             })
             .collect())
     }

@@ -1,71 +1,110 @@
-//! RTW caster refinement on the GPU: the per-frame caster subdivision of RTW's depth
-//! pass (Rosen, *Rectilinear Texture Warping for Fast Adaptive Shadow Mapping*, I3D
-//! 2012) as a compute pass that writes an indirect draw, so the CPU does no
-//! per-triangle work per frame.
+//! Caster refinement on the GPU: the per-frame caster subdivision of the depth passes
+//! that project vertices non-linearly, as a compute pass that writes indirect draws,
+//! so the CPU does no per-triangle work per frame. Two rules, each the twin of its
+//! CPU reference:
+//!
+//! - **RTW** (Rosen, *Rectilinear Texture Warping for Fast Adaptive Shadow Mapping*,
+//!   I3D 2012), over a matrix base (the uniform or the spot fit) or over a paraboloid
+//!   side (`point_rtw`): [`shadowmap_rtw::subdivide_for_rtw_with`], its options clamped
+//!   by the same [`RtwSubdivision::split_rule`]. Edges are halved; an edge's decision
+//!   depends on its two endpoints alone and is symmetric in them, so shared edges
+//!   split alike and a conforming mesh stays crack-free. Casters with a vertex the
+//!   base cannot map (behind a perspective light, at a paraboloid's light) are
+//!   dropped, as on the CPU.
+//! - **Paraboloid grid** (Brabec et al., DPSM; IPSM): [`subdivide_triangle`], with the
+//!   rule of [`SubdivisionOptions::split_rule`] and
+//!   [`shadowmap_paraboloid::DEVIATION_SAMPLES`]: each caster becomes the `n²` pieces
+//!   of its barycentric grid, `n` the most segments any of its edges needs on the
+//!   side.
 //!
 //! [`GpuRefine`] holds the casters in a storage buffer uploaded once. Each frame,
-//! [`GpuRefine::encode`] records three dispatches of `shaders/rtw_refine.wgsl` against
-//! the current warp tables (from the CPU, or built on the GPU by
-//! [`crate::rtw::GpuRtw`]), and [`crate::depth::ShadowDepthPass::encode_refined`]
-//! draws the result with `draw_indirect`:
+//! [`GpuRefine::encode`] records three dispatches of `shaders/refine.wgsl` for the
+//! technique of its [`DepthUniforms`] (RTW tables from the CPU, or built on the GPU
+//! by [`crate::rtw::GpuRtw`]; one layer per paraboloid side), and
+//! [`crate::depth::ShadowDepthPass::encode_refined`] draws each layer with
+//! `draw_indirect`:
 //!
 //! ```text
-//! count   one invocation per caster: refine to `levels` halvings (the rule of
-//!         shadowmap_rtw::subdivide_for_rtw, evaluated in f32), count the pieces
-//!         at every cap c in 0..=levels, add them to 64-bit totals per cap
-//! choose  one invocation: the finest cap whose total fits `capacity`; write
-//!         the draw arguments (3 x pieces vertices) and the stats
-//! emit    one invocation per caster: refine to the chosen cap, reserve its pieces
-//!         with one atomic add, write them (9 floats per triangle)
+//! count   one invocation per (caster, layer): its pieces at every cap c in
+//!         0..=levels (RTW: c halvings; grid: at most 2^c segments per edge),
+//!         added to 64-bit totals per layer and cap
+//! choose  one invocation: the finest cap whose total over the layers fits
+//!         `capacity`; each layer's draw arguments (its pieces after the previous
+//!         layer's) and the stats
+//! emit    one invocation per (caster, layer): refine to the chosen cap, reserve
+//!         the pieces with one atomic add, write them (9 floats per triangle)
 //! ```
 //!
-//! The split rule, the recursion and the pieces are those of the CPU reference
-//! [`shadowmap_rtw::subdivide_for_rtw`] (a WGSL twin, with the options clamped by the
-//! same [`RtwSubdivision::split_rule`]): the GPU draws the same mesh as the CPU path,
-//! up to `f32` rounding where an edge's error is within an ulp of the bound. An edge's
-//! decision depends on its two endpoints alone and is symmetric in them, so shared
-//! edges split alike and a conforming mesh stays crack-free. Every caster gets the
-//! same cap: when the finest refinement would overflow the capacity, the whole
-//! mesh is refined one level coarser (and so on down to the casters themselves),
-//! never truncated, and [`RefineStats::overflowed`] says so.
+//! The GPU draws the CPU's mesh up to `f32` rounding (an RTW edge whose error is
+//! within an ulp of the bound, a paraboloid edge whose deviation is): the tests
+//! compare the two depth maps. Every caster gets the same cap: when the finest
+//! refinement would overflow the capacity, the whole mesh is refined one level
+//! coarser (and so on down to the casters themselves), never truncated, and
+//! [`RefineStats::overflowed`] says so.
 //!
-//! Casters with a vertex the base cannot map (behind a perspective light) or with
-//! non-finite coordinates are drawn unsplit, as on the CPU.
+//! The pass uses no workgroup memory and no subgroup operations; invocations meet only
+//! in integer atomics, so its output is the same set of triangles whatever the
+//! subgroup size or scheduling (only the order within a layer varies, which the depth
+//! test's minimum does not see).
+//!
+//! [`subdivide_triangle`]: shadowmap_paraboloid::subdivide_triangle
 
 use std::num::NonZeroU64;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
+use shadowmap_paraboloid::{ParaboloidUniform, SubdivisionOptions};
 use shadowmap_rtw::RtwSubdivision;
 
-use crate::depth::{DepthUniforms, rtw_table_texels, table_buffer};
-use crate::uniforms::RtwShadowRaw;
+use crate::depth::{DepthUniforms, rtw_table_texels, table_buffer, warp_table_end};
+use crate::uniforms::ParaboloidLayerRaw;
 use crate::{BackendError, GpuContext, compose};
 
-/// Deepest refinement the pass supports: `max_segments` up to 1024, as
-/// [`RtwSubdivision`] allows.
+/// Deepest refinement the pass supports: RTW's `max_segments` up to 1024, as
+/// [`RtwSubdivision`] allows (the grid needs at most 8: 256 segments).
 pub const MAX_LEVELS: u32 = 10;
-/// Counts kept per caster (one per cap `0..=MAX_LEVELS`).
+/// Layers one refinement feeds (the sides of a dual paraboloid).
+pub const MAX_LAYERS: u32 = 2;
+/// Counts kept per caster and layer (one per cap `0..=MAX_LEVELS`).
 const CAPS: u64 = MAX_LEVELS as u64 + 1;
-/// Words of the state buffer (totals per cap, cursor, stats); see the shader.
-const STATE_WORDS: u64 = 32;
-/// First stats word in the state buffer: chosen cap, pieces drawn, overflow flag.
-const STATS_WORD: usize = 23;
+/// Words of the state buffer (totals per layer and cap, cursors, stats); see the
+/// shader.
+const STATE_WORDS: u64 = 64;
+/// Stats words in the state buffer: the chosen cap, then the pieces of each layer,
+/// then the overflow flag.
+const CHOSEN_WORD: usize = 46;
+const DRAWN_WORD: usize = 47;
+const OVERFLOW_WORD: usize = 49;
 /// Casters per workgroup of `count` and `emit`.
 const WORKGROUP: u32 = 64;
 /// Bytes of one refined (or original) triangle: three `vec3<f32>`.
 const TRIANGLE_BYTES: u64 = 36;
+/// Bytes of one layer's indirect draw arguments.
+const DRAW_BYTES: u64 = 16;
+/// Shader mode bits: the base is a paraboloid side; the grid rule.
+const MODE_PARABOLOID: u32 = 1;
+const MODE_GRID: u32 = 2;
+
+/// Byte offset of `layer`'s draw arguments in [`GpuRefine::draw_buffer`].
+#[must_use]
+pub const fn draw_offset(layer: usize) -> u64 {
+    layer as u64 * DRAW_BYTES
+}
 
 /// What [`GpuRefine::new`] builds.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct RefineOptions {
-    /// The split rule, as on the CPU ([`shadowmap_rtw::subdivide_for_rtw`]); its
+    /// The RTW split rule, as on the CPU ([`shadowmap_rtw::subdivide_for_rtw`]); its
     /// `resolution` is the depth pass's map side.
     pub subdivision: RtwSubdivision,
-    /// Most triangles the refined buffer holds, at least the caster count and at
-    /// most what the device's storage buffers allow. Default 2^20 (36 MiB): the
-    /// city block over 256-cell tables into a 2048² map takes 0.72 M.
+    /// The paraboloid rule, as on the CPU
+    /// ([`shadowmap_paraboloid::subdivide_triangle`]); its `resolution` is the depth
+    /// pass's map side.
+    pub paraboloid: SubdivisionOptions,
+    /// Most triangles the refined buffer holds over all layers, at least the caster
+    /// count and at most what the device's storage buffers allow. Default 2^20 (36
+    /// MiB): the city block over 256-cell tables into a 2048² map takes 0.72 M.
     pub capacity: u32,
 }
 
@@ -73,16 +112,30 @@ impl Default for RefineOptions {
     fn default() -> Self {
         Self {
             subdivision: RtwSubdivision::default(),
+            paraboloid: SubdivisionOptions::default(),
             capacity: 1 << 20,
         }
     }
 }
 
 impl RefineOptions {
-    /// With this split rule.
+    /// With this RTW split rule.
     #[must_use]
     pub const fn with_subdivision(mut self, subdivision: RtwSubdivision) -> Self {
         self.subdivision = subdivision;
+        self
+    }
+    /// With this paraboloid rule.
+    #[must_use]
+    pub const fn with_paraboloid(mut self, paraboloid: SubdivisionOptions) -> Self {
+        self.paraboloid = paraboloid;
+        self
+    }
+    /// Both rules for a map of this many texels per side.
+    #[must_use]
+    pub const fn with_resolution(mut self, resolution: u32) -> Self {
+        self.subdivision = self.subdivision.with_resolution(resolution);
+        self.paraboloid = self.paraboloid.with_resolution(resolution);
         self
     }
     /// With room for this many refined triangles.
@@ -96,15 +149,28 @@ impl RefineOptions {
 /// What the last submitted refinement drew ([`GpuRefine::read_stats`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RefineStats {
-    /// Triangles written (and drawn).
+    /// Triangles written (and drawn), over all layers.
     pub triangles: u32,
-    /// Halvings per original edge that fitted the capacity.
+    /// Triangles of each layer (layer 0 first in the buffer); 0 past the layers.
+    pub layer_triangles: [u32; MAX_LAYERS as usize],
+    /// The cap that fitted: RTW halvings per original edge, or `log2` of the grid's
+    /// most segments per edge.
     pub levels: u32,
-    /// Halvings asked for (`ceil(log2(max_segments))`).
+    /// The cap asked for (`ceil(log2(max_segments))` of the rule).
     pub requested_levels: u32,
     /// Whether the full refinement would have overflowed the capacity, so a coarser
     /// one was drawn.
     pub overflowed: bool,
+}
+
+/// One layer of WGSL `RefineParams`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+struct RefineLayerRaw {
+    /// Table offsets and texels: `u` offset, `u` texels, `v` offset, `v` texels.
+    tables: [u32; 4],
+    /// Pieces per unit of base `u` and `v`, error scale; the paraboloid side.
+    rule: [f32; 4],
 }
 
 /// WGSL `RefineParams`.
@@ -112,20 +178,24 @@ pub struct RefineStats {
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 struct RefineParamsRaw {
     uv_from_world: [[f32; 4]; 4],
-    /// Pieces per unit of base `u` and `v`, error scale, unused.
-    rule: [f32; 4],
-    /// Table texels `u`, `v`, halvings, casters.
+    paraboloid: ParaboloidUniform,
+    /// Grid rule: texels per side, tolerance, most segments; unused.
+    grid: [f32; 4],
+    /// Mode bits, levels, casters, layers.
     sizes: [u32; 4],
     /// Capacity in triangles, unused.
     limits: [u32; 4],
+    layers: [RefineLayerRaw; MAX_LAYERS as usize],
 }
 
-/// Casters on the GPU and the compute pass that refines them for RTW's depth pass.
+/// Casters on the GPU and the compute pass that refines them for a depth pass.
 #[derive(Debug)]
 pub struct GpuRefine {
     options: RefineOptions,
     casters: u32,
-    levels: u32,
+    /// Layers and requested levels of the last [`GpuRefine::encode`].
+    layers: u32,
+    requested_levels: u32,
     count: wgpu::ComputePipeline,
     choose: wgpu::ComputePipeline,
     emit: wgpu::ComputePipeline,
@@ -145,8 +215,8 @@ impl GpuRefine {
     ///
     /// # Errors
     /// [`BackendError::InvalidInput`] for no casters, a capacity below the caster
-    /// count, or buffers or dispatches past the device's limits;
-    /// [`BackendError::Wgpu`] if wgpu rejects a resource.
+    /// count, paraboloid options out of range, or buffers or dispatches past the
+    /// device's limits; [`BackendError::Wgpu`] if wgpu rejects a resource.
     pub fn new(
         ctx: &GpuContext,
         casters: &[[Vec3; 3]],
@@ -162,9 +232,13 @@ impl GpuRefine {
                 "refine: capacity below the caster count or above u32::MAX / 3",
             ));
         }
+        options
+            .paraboloid
+            .split_rule()
+            .map_err(|_| BackendError::InvalidInput("refine: paraboloid options out of range"))?;
         let limits = ctx.device.limits();
         let largest = u64::from(options.capacity) * TRIANGLE_BYTES;
-        let counts = u64::from(n) * CAPS * 4;
+        let counts = u64::from(n) * u64::from(MAX_LAYERS) * CAPS * 4;
         if largest.max(counts)
             > limits
                 .max_storage_buffer_binding_size
@@ -213,7 +287,7 @@ impl GpuRefine {
         );
         let piece_counts = buffer(
             "shadowmap refine piece counts",
-            u64::from(n) * CAPS * 4,
+            u64::from(n) * u64::from(MAX_LAYERS) * CAPS * 4,
             U::STORAGE,
         );
         let refined = buffer(
@@ -223,7 +297,7 @@ impl GpuRefine {
         );
         let draw = buffer(
             "shadowmap refine draw",
-            16,
+            u64::from(MAX_LAYERS) * DRAW_BYTES,
             U::STORAGE | U::INDIRECT | U::COPY_SRC,
         );
         let tables = table_buffer(device, 4);
@@ -245,7 +319,8 @@ impl GpuRefine {
         Ok(Self {
             options: *options,
             casters: n,
-            levels: options.subdivision.split_rule(1, 1).levels,
+            layers: 1,
+            requested_levels: 0,
             count,
             choose,
             emit,
@@ -273,88 +348,160 @@ impl GpuRefine {
         self.casters
     }
 
-    /// The refined triangles (a `VERTEX` buffer of `vec3<f32>`, three per triangle).
+    /// Layers of the last [`GpuRefine::encode`] (1 before any).
+    #[must_use]
+    pub const fn layers(&self) -> u32 {
+        self.layers
+    }
+
+    /// The refined triangles (a `VERTEX` buffer of `vec3<f32>`, three per triangle;
+    /// each layer's after the previous layer's).
     #[must_use]
     pub const fn vertices(&self) -> &wgpu::Buffer {
         &self.refined
     }
 
-    /// The indirect draw arguments (`vertex_count, instance_count, first_vertex,
-    /// first_instance`), written by the pass.
+    /// The indirect draw arguments, one set per layer at [`draw_offset`]
+    /// (`vertex_count, instance_count, first_vertex, first_instance`), written by
+    /// the pass.
     #[must_use]
     pub const fn draw_buffer(&self) -> &wgpu::Buffer {
         &self.draw
     }
 
-    /// Records one refinement against the base and tables of `uniforms` (an RTW
-    /// [`DepthUniforms`]: tables from a slice are queued, tables in a GPU buffer are
-    /// copied inside `encoder`, so a build recorded earlier in it is what the pass
-    /// sees). The parameters go through `queue.write_buffer`: record at most one
-    /// `encode` per submission.
+    /// Records one refinement for the technique of `uniforms`: RTW over a matrix base
+    /// ([`DepthUniforms::Rtw`], [`DepthUniforms::RtwGpuTables`]; tables from a slice
+    /// are queued, tables in a GPU buffer are copied inside `encoder`, so a build
+    /// recorded earlier in it is what the pass sees), RTW over paraboloid sides
+    /// ([`DepthUniforms::WarpedParaboloid`]) or the paraboloid grid
+    /// ([`DepthUniforms::Paraboloid`]). The parameters go through
+    /// `queue.write_buffer`: record at most one `encode` per submission.
     ///
     /// # Errors
-    /// [`BackendError::InvalidInput`] for uniforms of another technique or tables
-    /// shorter than their sizes (or a table buffer without `COPY_SRC`).
+    /// [`BackendError::InvalidInput`] for matrix uniforms, no layer or more than
+    /// [`MAX_LAYERS`], or tables shorter than their sizes (or a table buffer without
+    /// `COPY_SRC`).
     pub fn encode(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         uniforms: &DepthUniforms<'_>,
     ) -> Result<(), BackendError> {
-        let raw = self.upload_tables(ctx, encoder, uniforms)?;
-        let rule = self
-            .options
-            .subdivision
-            .split_rule(raw.sizes[0] as usize, raw.sizes[1] as usize);
-        let params = RefineParamsRaw {
-            uv_from_world: raw.uv_from_world,
-            rule: [
-                rule.pieces.x as f32,
-                rule.pieces.y as f32,
-                rule.error_scale as f32,
-                0.0,
-            ],
-            sizes: [raw.sizes[0], raw.sizes[1], rule.levels, self.casters],
-            limits: [self.options.capacity, 0, 0, 0],
-        };
+        let mut params = self.params_for(uniforms)?;
+        self.upload_tables(ctx, encoder, uniforms)?;
+        params.sizes[2] = self.casters;
+        params.limits[0] = self.options.capacity;
+        self.layers = params.sizes[3];
+        self.requested_levels = params.sizes[1];
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         encoder.clear_buffer(&self.state, 0, None);
         let groups = self.casters.div_ceil(WORKGROUP);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("shadowmap rtw refine"),
+            label: Some("shadowmap refine"),
             timestamp_writes: None,
         });
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.set_pipeline(&self.count);
-        pass.dispatch_workgroups(groups, 1, 1);
+        pass.dispatch_workgroups(groups, self.layers, 1);
         pass.set_pipeline(&self.choose);
         pass.dispatch_workgroups(1, 1, 1);
         pass.set_pipeline(&self.emit);
-        pass.dispatch_workgroups(groups, 1, 1);
+        pass.dispatch_workgroups(groups, self.layers, 1);
         Ok(())
     }
 
-    /// Brings the RTW tables of `uniforms` into the pass's table buffer (queued from
-    /// a slice, copied inside `encoder` from a GPU buffer) and returns their block.
-    fn upload_tables<'u>(
+    /// The parameters for `uniforms` (casters and capacity filled in by the caller).
+    fn params_for(&self, uniforms: &DepthUniforms<'_>) -> Result<RefineParamsRaw, BackendError> {
+        let mut params = RefineParamsRaw::zeroed();
+        match uniforms {
+            DepthUniforms::Rtw { raw, .. } | DepthUniforms::RtwGpuTables { raw, .. } => {
+                let [u, v, ..] = raw.sizes;
+                let rule = self.options.subdivision.split_rule(u as usize, v as usize);
+                params.uv_from_world = raw.uv_from_world;
+                params.sizes = [0, rule.levels, 0, 1];
+                params.layers[0] = RefineLayerRaw {
+                    tables: [0, u, u, v],
+                    rule: [
+                        rule.pieces.x as f32,
+                        rule.pieces.y as f32,
+                        rule.error_scale as f32,
+                        0.0,
+                    ],
+                };
+            }
+            DepthUniforms::Paraboloid(layers) => {
+                let rule = self
+                    .options
+                    .paraboloid
+                    .split_rule()
+                    .map_err(|_| BackendError::InvalidInput("refine: paraboloid options"))?;
+                paraboloid_params(&mut params, layers, MODE_GRID, rule.levels)?;
+                params.grid = [
+                    rule.resolution as f32,
+                    rule.tolerance_texels as f32,
+                    rule.max_segments as f32,
+                    0.0,
+                ];
+            }
+            DepthUniforms::WarpedParaboloid { layers, .. } => {
+                // As eval's reference: enough pieces an edge to cross the side's
+                // whole disc (diameter `1 / zoom` of base texture space) in pieces
+                // of the span bound.
+                let zoom = layers
+                    .first()
+                    .map_or(1.0, |l| l.map.far_zoom_reversed_dual[1]);
+                let subdivision = |layer: &ParaboloidLayerRaw| {
+                    let [_, u, _, v] = layer.warp;
+                    self.options
+                        .subdivision
+                        .with_segments_for_extent(1.0 / f64::from(zoom), u.max(v) as usize)
+                };
+                let levels = layers
+                    .iter()
+                    .map(|l| subdivision(l).split_rule(1, 1).levels)
+                    .max()
+                    .unwrap_or(0);
+                paraboloid_params(&mut params, layers, 0, levels)?;
+                for (slot, layer) in params.layers.iter_mut().zip(layers.iter()) {
+                    let [_, u, _, v] = layer.warp;
+                    let rule = subdivision(layer).split_rule(u as usize, v as usize);
+                    slot.tables = layer.warp;
+                    slot.rule = [
+                        rule.pieces.x as f32,
+                        rule.pieces.y as f32,
+                        rule.error_scale as f32,
+                        layer.side[0],
+                    ];
+                }
+            }
+            DepthUniforms::Matrix(_) => {
+                return Err(BackendError::InvalidInput(
+                    "refine: matrix techniques need no refinement",
+                ));
+            }
+        }
+        Ok(params)
+    }
+
+    /// Brings the tables of `uniforms` into the pass's table buffer (queued from a
+    /// slice, copied inside `encoder` from a GPU buffer).
+    fn upload_tables(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        uniforms: &'u DepthUniforms<'_>,
-    ) -> Result<&'u RtwShadowRaw, BackendError> {
-        match uniforms {
-            DepthUniforms::Rtw { raw, tables } => {
-                if tables.len() < rtw_table_texels(raw).max(1) {
-                    return Err(BackendError::InvalidInput(
-                        "RTW tables shorter than their sizes",
-                    ));
-                }
-                let bytes: &[u8] = bytemuck::cast_slice(tables);
-                self.grow_tables(ctx, bytes.len() as u64);
-                ctx.queue.write_buffer(&self.tables, 0, bytes);
-                Ok(raw)
-            }
+        uniforms: &DepthUniforms<'_>,
+    ) -> Result<(), BackendError> {
+        let (tables, needed): (&[f32], usize) = match uniforms {
+            DepthUniforms::Rtw { raw, tables } => (tables, rtw_table_texels(raw)),
+            DepthUniforms::WarpedParaboloid { layers, tables } => (
+                tables,
+                layers
+                    .iter()
+                    .map(|l| warp_table_end(&l.warp))
+                    .max()
+                    .unwrap_or(0),
+            ),
             DepthUniforms::RtwGpuTables { raw, tables } => {
                 let bytes = (rtw_table_texels(raw).max(1) * 4) as u64;
                 if tables.size() < bytes || !tables.usage().contains(wgpu::BufferUsages::COPY_SRC) {
@@ -364,12 +511,19 @@ impl GpuRefine {
                 }
                 self.grow_tables(ctx, bytes);
                 encoder.copy_buffer_to_buffer(tables, 0, &self.tables, 0, bytes);
-                Ok(raw)
+                return Ok(());
             }
-            DepthUniforms::Matrix(_) | DepthUniforms::Paraboloid(_) => {
-                Err(BackendError::InvalidInput("refine: uniforms are not RTW's"))
-            }
+            DepthUniforms::Matrix(_) | DepthUniforms::Paraboloid(_) => return Ok(()),
+        };
+        if tables.len() < needed.max(1) {
+            return Err(BackendError::InvalidInput(
+                "RTW tables shorter than their sizes",
+            ));
         }
+        let bytes: &[u8] = bytemuck::cast_slice(tables);
+        self.grow_tables(ctx, bytes.len() as u64);
+        ctx.queue.write_buffer(&self.tables, 0, bytes);
+        Ok(())
     }
 
     /// Reads the stats of the last submitted refinement. Blocks until the GPU is
@@ -379,19 +533,25 @@ impl GpuRefine {
     /// [`BackendError::Readback`].
     pub fn read_stats(&self, ctx: &GpuContext) -> Result<RefineStats, BackendError> {
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&ctx.read_buffer(&self.state)?);
-        match words.get(STATS_WORD..STATS_WORD + 3) {
-            Some(&[levels, triangles, overflowed]) => Ok(RefineStats {
-                triangles,
-                levels,
-                requested_levels: self.levels,
-                overflowed: overflowed != 0,
-            }),
-            _ => Err(BackendError::Readback("short refine stats".into())),
-        }
+        let word = |i: usize| {
+            words
+                .get(i)
+                .copied()
+                .ok_or_else(|| BackendError::Readback("short refine stats".into()))
+        };
+        let layer_triangles = [word(DRAWN_WORD)?, word(DRAWN_WORD + 1)?];
+        Ok(RefineStats {
+            triangles: layer_triangles.iter().sum(),
+            layer_triangles,
+            levels: word(CHOSEN_WORD)?,
+            requested_levels: self.requested_levels,
+            overflowed: word(OVERFLOW_WORD)? != 0,
+        })
     }
 
-    /// Reads the refined triangles of the last submitted refinement (a test and
-    /// debug path: it allocates and blocks).
+    /// Reads the refined triangles of the last submitted refinement, every layer's
+    /// in layer order ([`RefineStats::layer_triangles`] splits them; a test and debug
+    /// path: it allocates and blocks).
     ///
     /// # Errors
     /// [`BackendError::Readback`].
@@ -432,19 +592,40 @@ impl GpuRefine {
     }
 }
 
-/// The `count`, `choose` and `emit` pipelines of `rtw_refine.wgsl` (its table
-/// sampler composed in) over `layout`.
+/// The paraboloid base of `layers` (one map, one side per layer) into `params`.
+fn paraboloid_params(
+    params: &mut RefineParamsRaw,
+    layers: &[ParaboloidLayerRaw],
+    mode: u32,
+    levels: u32,
+) -> Result<(), BackendError> {
+    let count = u32::try_from(layers.len()).unwrap_or(u32::MAX);
+    let Some(first) = layers.first().filter(|_| count <= MAX_LAYERS) else {
+        return Err(BackendError::InvalidInput(
+            "refine: one or two paraboloid layers",
+        ));
+    };
+    params.paraboloid = first.map;
+    params.sizes = [MODE_PARABOLOID | mode, levels, 0, count];
+    for (slot, layer) in params.layers.iter_mut().zip(layers) {
+        slot.rule[3] = layer.side[0];
+    }
+    Ok(())
+}
+
+/// The `count`, `choose` and `emit` pipelines of `refine.wgsl` (its shared functions
+/// composed in) over `layout`.
 fn pipelines(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
 ) -> Result<[wgpu::ComputePipeline; 3], BackendError> {
-    let source = compose::rtw_refine()?;
+    let source = compose::refine()?;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("shadowmap rtw refine"),
+        label: Some("shadowmap refine"),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("shadowmap rtw refine"),
+        label: Some("shadowmap refine"),
         bind_group_layouts: &[Some(layout)],
         immediate_size: 0,
     });
@@ -477,7 +658,7 @@ fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let read = wgpu::BufferBindingType::Storage { read_only: true };
     let write = wgpu::BufferBindingType::Storage { read_only: false };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("shadowmap rtw refine"),
+        label: Some("shadowmap refine"),
         entries: &[
             entry(
                 0,
@@ -489,7 +670,7 @@ fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             entry(3, write, STATE_WORDS * 4),
             entry(4, write, 4),
             entry(5, write, 4),
-            entry(6, write, 16),
+            entry(6, write, u64::from(MAX_LAYERS) * DRAW_BYTES),
         ],
     })
 }
@@ -509,7 +690,7 @@ fn make_bind_group(
         })
         .collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("shadowmap rtw refine"),
+        label: Some("shadowmap refine"),
         layout,
         entries: &entries,
     })
@@ -523,7 +704,7 @@ mod tests {
     /// shader's limits are this module's.
     #[test]
     fn params_and_limits_match_the_shader() {
-        let source = compose::rtw_refine().unwrap();
+        let source = compose::refine().unwrap();
         let module = naga::front::wgsl::parse_str(&source).expect("parses");
         let mut layouter = naga::proc::Layouter::default();
         layouter.update(module.to_ctx()).expect("layout");
@@ -537,11 +718,23 @@ mod tests {
         for (name, value) in [
             ("MAX_LEVELS", u64::from(MAX_LEVELS)),
             ("CAPS", CAPS),
-            ("CHOSEN", STATS_WORD as u64),
+            ("MAX_LAYERS", u64::from(MAX_LAYERS)),
+            ("CHOSEN", CHOSEN_WORD as u64),
+            ("DRAWN", DRAWN_WORD as u64),
+            ("OVERFLOW", OVERFLOW_WORD as u64),
+            ("MODE_PARABOLOID", u64::from(MODE_PARABOLOID)),
+            ("MODE_GRID", u64::from(MODE_GRID)),
         ] {
             let line = format!("const {name}: u32 = {value}u;");
             assert!(source.contains(&line), "shader lacks `{line}`");
         }
+        let samples = shadowmap_paraboloid::DEVIATION_SAMPLES.map(|f| format!("{f:?}"));
+        let line = format!(
+            "const DEVIATION_SAMPLES = array<f32, 3>({});",
+            samples.join(", ")
+        );
+        assert!(source.contains(&line), "shader lacks `{line}`");
+        assert!(source.contains(&format!("array<u32, {}>", 4 * MAX_LAYERS)));
         assert!(source.contains(&format!("array<atomic<u32>, {STATE_WORDS}>")));
         assert!(source.contains(&format!("@workgroup_size({WORKGROUP})")));
     }

@@ -34,6 +34,38 @@
 //! `WarpOptions::temporal`. The history flag lives on the GPU, so several builds in
 //! one submission chain correctly.
 //!
+//! # Memory, barriers, subgroups, reduction order
+//!
+//! The NVIDIA failure of an earlier version (an H100 reported `identity_fallback =
+//! [true, true]` for a 64x48 map with importance near `f32::MAX`) was a division by a
+//! peak above 2^126, where WGSL guarantees `x / y` only for `|y|` in `[2^-126,
+//! 2^126]` and NVIDIA's reciprocal flushes to zero; `rtw_warp.wgsl` now scales by
+//! exponent bits instead. The other suspects were audited:
+//!
+//! - **Workgroup memory.** Every workgroup variable is written before a barrier and
+//!   read after it (the counters and maxima by invocation 0, the scan by every
+//!   invocation). The pipelines are compiled with wgpu's zero-initialization of
+//!   workgroup memory off, so the tests run the shaders as a driver that leaves it
+//!   uninitialized would.
+//! - **Storage memory.** The cells, maxima and counts are cleared by the encoder
+//!   every frame. The density history was read (times a zero weight) on the first
+//!   build, and `0 * NaN` is NaN: it is now read only when there is history, and a
+//!   test fills a fresh history with NaN first.
+//! - **Barriers.** The only reads of storage written by another invocation (the
+//!   scan's chunks read the densities of neighbouring texels) follow a
+//!   `storageBarrier` and a `workgroupBarrier`; every barrier is in uniform control
+//!   flow (the early exit of a constant density goes through `workgroupUniformLoad`).
+//! - **Subgroups.** None are used: no result depends on the subgroup size (32 on
+//!   NVIDIA, 8 to 64 elsewhere).
+//! - **Reduction order.** Maxima and minima are integer atomics on float bits (order
+//!   free for the finite, non-negative values they hold), counts integer atomics; the
+//!   one floating-point sum (the trapezoid cumulative sum) is a fixed chunked
+//!   Hillis-Steele scan over the workgroup's 256 lanes, the same order on every GPU.
+//! - **Sizes.** Every loop strides by its workgroup size and every invocation checks
+//!   its bounds; the tests cover maps from 3x2 to 1000x5 (257 wide: one lane past the
+//!   build's workgroup) and G-buffers that are not multiples of the 16x16 splat
+//!   workgroup.
+//!
 //! # Example
 //! ```no_run
 //! use glam::{Mat4, Vec3};
@@ -140,20 +172,14 @@ impl RtwGBufferTextures {
             }
         }
         let texture = |label: &str, texels: &[Vec4]| {
-            let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: GBUFFER_FORMAT,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
+            let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+            let texture = crate::context::texture_2d(
+                &ctx.device,
+                label,
+                (width, height),
+                GBUFFER_FORMAT,
+                usage,
+            );
             ctx.queue.write_texture(
                 texture.as_image_copy(),
                 bytemuck::cast_slice(texels),
@@ -337,7 +363,12 @@ impl GpuRtw {
                 layout: None,
                 module: &module,
                 entry_point: Some(entry),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    // Every workgroup variable is written before it is read (see
+                    // "Memory" in the module docs); the tests run without the zeroing.
+                    zero_initialize_workgroup_memory: false,
+                    ..Default::default()
+                },
                 cache: None,
             })
         };
@@ -451,16 +482,35 @@ impl GpuRtw {
     }
 
     /// Records one frame: clear, splat the G-buffer over `base`, collapse, build the
-    /// tables.
+    /// tables ([`GpuRtw::encode_importance`] then [`GpuRtw::encode_tables`]).
     ///
     /// The base transform goes to a uniform buffer through `queue.write_buffer`, which
     /// lands before the next submission: record at most one `encode` per submission.
     ///
     /// # Errors
+    /// As [`GpuRtw::encode_importance`].
+    pub fn encode(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        gbuffer: &RtwGBuffer<'_>,
+        base: &ShadowTransform,
+    ) -> Result<(), BackendError> {
+        self.encode_importance(ctx, encoder, gbuffer, base)?;
+        self.encode_tables(encoder);
+        Ok(())
+    }
+
+    /// Records the analysis's first half in its own compute pass: clear, splat the
+    /// G-buffer over `base` into the importance map, collapse it to column and row
+    /// maxima. Follow it with [`GpuRtw::encode_tables`] (the split lets a profiler
+    /// time the two halves).
+    ///
+    /// # Errors
     /// [`BackendError::InvalidInput`] for a non-finite base transform or light, G-buffer
     /// views of another format or of different sizes, or a G-buffer too large to
     /// dispatch.
-    pub fn encode(
+    pub fn encode_importance(
         &self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
@@ -518,7 +568,23 @@ impl GpuRtw {
         };
         ctx.queue
             .write_buffer(&self.importance_params, 0, bytemuck::bytes_of(&raw));
-        let splat_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let splat_group = self.splat_group(&ctx.device, gbuffer);
+        encoder.clear_buffer(&self.cells, 0, None);
+        encoder.clear_buffer(&self.maxima, 0, None);
+        encoder.clear_buffer(&self.counts, 0, None);
+        let mut pass = compute_pass(encoder, "rtw importance");
+        pass.set_pipeline(&self.splat);
+        pass.set_bind_group(0, &splat_group, &[]);
+        pass.dispatch_workgroups(groups_x, groups_y, 1);
+        pass.set_pipeline(&self.collapse);
+        pass.set_bind_group(0, &self.collapse_group, &[]);
+        pass.dispatch_workgroups(self.height, 1, 1);
+        Ok(())
+    }
+
+    /// The splat's bind group over this frame's G-buffer views.
+    fn splat_group(&self, device: &wgpu::Device, gbuffer: &RtwGBuffer<'_>) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("rtw splat"),
             layout: &self.splat.get_bind_group_layout(0),
             entries: &[
@@ -543,24 +609,17 @@ impl GpuRtw {
                     resource: self.counts.as_entire_binding(),
                 },
             ],
-        });
-        encoder.clear_buffer(&self.cells, 0, None);
-        encoder.clear_buffer(&self.maxima, 0, None);
-        encoder.clear_buffer(&self.counts, 0, None);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("rtw"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&self.splat);
-        pass.set_bind_group(0, &splat_group, &[]);
-        pass.dispatch_workgroups(groups_x, groups_y, 1);
-        pass.set_pipeline(&self.collapse);
-        pass.set_bind_group(0, &self.collapse_group, &[]);
-        pass.dispatch_workgroups(self.height, 1, 1);
+        })
+    }
+
+    /// Records the analysis's second half in its own compute pass: blur,
+    /// normalization, temporal smoothing, floor and the two tables, from the maxima
+    /// of the last [`GpuRtw::encode_importance`].
+    pub fn encode_tables(&self, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = compute_pass(encoder, "rtw tables");
         pass.set_pipeline(&self.build);
         pass.set_bind_group(0, &self.build_group, &[]);
         pass.dispatch_workgroups(2, 1, 1);
-        Ok(())
     }
 
     /// Reads the warp tables of the last submitted build back: `(u table, v table)`.
@@ -623,6 +682,14 @@ impl GpuRtw {
     }
 }
 
+/// A compute pass without timestamp writes.
+fn compute_pass<'e>(encoder: &'e mut wgpu::CommandEncoder, label: &str) -> wgpu::ComputePass<'e> {
+    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: None,
+    })
+}
+
 fn f32_words(words: &[u32]) -> Vec<f32> {
     words.iter().map(|&w| f32::from_bits(w)).collect()
 }
@@ -646,6 +713,67 @@ mod tests {
             assert!(flat[r as usize + 1..].iter().all(|&x| x == 0.0));
             assert!(flat[..=r as usize].windows(2).all(|p| p[0] >= p[1]));
         }
+    }
+
+    /// A fresh (or reset) history may hold anything: the first build must not read
+    /// it. The density buffer is filled with NaN, then the tables must be the CPU's
+    /// first build, with temporal smoothing on.
+    #[test]
+    fn a_first_build_ignores_whatever_the_history_holds() {
+        use glam::{Mat4, Vec3};
+        use shadowmap_rtw::{ImportanceMap, WarpMaps};
+        let Some(ctx) =
+            crate::context::test_context("a_first_build_ignores_whatever_the_history_holds")
+        else {
+            return;
+        };
+        // uv = (x, y) for x, y in [0, 1].
+        let clip_from_world = Mat4::from_cols_array(&[
+            2.0, 0.0, 0.0, 0.0, 0.0, -2.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, -1.0, 1.0, 0.0, 1.0,
+        ]);
+        let base = ShadowTransform::new(
+            Mat4::IDENTITY,
+            clip_from_world,
+            false,
+            LightDirection::Directional(Vec3::NEG_Z),
+        );
+        let (width, height) = (37, 29);
+        let warp = WarpOptions::default().with_temporal(0.5);
+        let importance = ImportanceOptions::default();
+        let rtw = GpuRtw::new(&ctx, width, height, &warp, &importance).unwrap();
+        let nan = vec![f32::NAN; (width + height) as usize];
+        ctx.queue
+            .write_buffer(&rtw.density, 0, bytemuck::cast_slice(&nan));
+        let samples: Vec<EyeSample> = (0..15)
+            .map(|i| EyeSample {
+                position: Vec3::new(0.05 + 0.06 * i as f32, 0.9 - 0.05 * i as f32, 0.5),
+                normal: Vec3::Z,
+                eye_distance: 1.0 + i as f32,
+            })
+            .collect();
+        let texels: Vec<Option<EyeSample>> = samples.iter().copied().map(Some).collect();
+        let gbuffer = RtwGBufferTextures::from_samples(&ctx, 5, 3, &texels, None).unwrap();
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        rtw.encode(&ctx, &mut encoder, &gbuffer.as_gbuffer(), &base)
+            .unwrap();
+        ctx.queue.submit([encoder.finish()]);
+        let (u, v) = rtw.read_tables(&ctx).unwrap();
+
+        let mut map = ImportanceMap::new(width, height).unwrap();
+        map.accumulate_backward(&base, &samples, None, &importance)
+            .unwrap();
+        let mut cpu = WarpMaps::new(width, height).unwrap();
+        cpu.build(&map, &warp).unwrap();
+        for (gpu, cpu) in [(&u, cpu.x_table()), (&v, cpu.y_table())] {
+            assert!(gpu.iter().all(|t| t.is_finite()), "{gpu:?}");
+            let worst = gpu
+                .iter()
+                .zip(cpu)
+                .map(|(g, c)| (g - c).abs())
+                .fold(0.0f32, f32::max);
+            assert!(worst < 1e-4, "tables differ by {worst}");
+        }
+        assert!(u.iter().any(|t| t.abs() > 1e-3), "a real warp");
     }
 
     #[test]

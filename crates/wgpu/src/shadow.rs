@@ -22,7 +22,7 @@
 //! ```
 
 use glam::Vec3;
-use shadowmap::{Fitted, Shadow, Technique};
+use shadowmap::{Fitted, Shadow};
 use shadowmap_frustum::Camera;
 
 use crate::render::{HeadlessRenderer, RenderOptions, RenderedFrame, ShadowTechnique};
@@ -53,20 +53,17 @@ impl HeadlessRenderer {
 
 /// Calls `f` with the renderer's [`ShadowTechnique`] for a fitted shadow: the one
 /// match from the umbrella crate's results to the backend's passes (RTW's borrowed
-/// view of its tables lives for the call).
+/// view of its tables lives for the call). RTW runs over whatever base it was fitted
+/// on: the uniform fit (orthographic), the spot fit (perspective) or the sides of the
+/// IPSM paraboloid (`point_rtw`).
 ///
 /// # Errors
 /// [`BackendError::InvalidInput`] for a result the backend has no pass for (RTW over
-/// the spot fit or over a paraboloid, a `Fitted` variant added after this backend).
+/// cube faces, a `Fitted` variant added after this backend).
 pub fn with_technique<R>(
     shadow: &Shadow,
     f: impl FnOnce(&ShadowTechnique<'_>) -> R,
 ) -> Result<R, BackendError> {
-    // The RTW passes warp an orthographic base; RTW over the spot fit's perspective
-    // base has no pass yet.
-    if matches!(shadow.technique(), Technique::SpotRtw(_)) {
-        return Err(UNSUPPORTED);
-    }
     let rtw = shadow.rtw();
     let technique = match (shadow.fitted(), &rtw) {
         (_, Some(rtw)) => ShadowTechnique::Rtw(rtw),
@@ -74,10 +71,16 @@ pub fn with_technique<R>(
         (Fitted::Lispsm(s), _) => ShadowTechnique::Matrix(&s.transform),
         (Fitted::Tsm(s), _) => ShadowTechnique::Matrix(&s.transform),
         (Fitted::Spot(s), _) => ShadowTechnique::Matrix(&s.transform),
+        (Fitted::SpotWarp(s), _) => ShadowTechnique::Matrix(&s.transform),
         (Fitted::Xpsm(x), _) => ShadowTechnique::Xpsm(x),
         (Fitted::Cascades(set), _) => ShadowTechnique::Cascades(set),
         (Fitted::Dpsm(map), _) => ShadowTechnique::Paraboloid(map),
         (Fitted::Ipsm(plan), _) => ShadowTechnique::Paraboloid(&plan.map),
+        (Fitted::PointRtw { plan, front, back }, _) => ShadowTechnique::ParaboloidRtw {
+            map: &plan.map,
+            front,
+            back: back.as_ref(),
+        },
         (Fitted::WarpedCascades { cascades, .. }, _) => ShadowTechnique::WarpedCascades(cascades),
         (Fitted::Cube(cube), _) => ShadowTechnique::Cube(cube),
         _ => return Err(UNSUPPORTED),

@@ -24,8 +24,8 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
 use shadowmap_frustum::{CascadeSet, LightDirection, MAX_CASCADES, ShadowTransform};
-use shadowmap_paraboloid::{ParaboloidMap, ParaboloidUniform, Side};
-use shadowmap_rtw::RtwShadow;
+use shadowmap_paraboloid::{CubeMap, ParaboloidMap, ParaboloidUniform, Side};
+use shadowmap_rtw::{RtwShadow, WarpMaps};
 use shadowmap_warp::{LispsmShadow, TsmShadow, WarpedCascades, XpsmShadow};
 
 /// Converts a math-crate result into the uniform block its shaders read.
@@ -107,6 +107,12 @@ pub struct CascadeShadowRaw {
     pub split_far: [[f32; 4]; 2],
     /// Blend band at the far end of cascade `i` (`CascadeSplits::band_width(i)`).
     pub band_width: [[f32; 4]; 2],
+    /// Scale of layer `i`'s `uv` where its map fills only the top-left corner of
+    /// the layer (cube faces of different sizes, see
+    /// `CubeFace::clip_from_world_in_layer`): `(x, y)` of layer `2k` then of
+    /// `2k + 1` in row `k`; 1 where the map fills the layer. Selection reads the
+    /// unscaled `uv`.
+    pub layer_uv_scale: [[f32; 4]; MAX_CASCADES / 2],
     /// Number of cascades.
     pub count: u32,
     /// Reversed-Z (0 or 1).
@@ -119,6 +125,38 @@ pub struct CascadeShadowRaw {
 }
 
 impl CascadeShadowRaw {
+    /// No layer, every layer's map filling its layer (`layer_uv_scale` 1).
+    #[must_use]
+    pub fn unscaled() -> Self {
+        Self {
+            layer_uv_scale: [[1.0; 4]; MAX_CASCADES / 2],
+            ..Self::zeroed()
+        }
+    }
+
+    /// The cascades lookup of a cube map: one perspective `uv_from_world` per kept
+    /// face, selected by projection without a margin (adjacent windows meet at the
+    /// face edges), each face's `uv` scaled to its corner of a layer of the largest
+    /// face's side ([`cube_layers`]).
+    #[must_use]
+    pub fn from_cube(cube: &CubeMap) -> Self {
+        let mut raw = Self::unscaled();
+        let side = cube.largest_side();
+        for (layer, face) in cube.faces.iter().enumerate().take(MAX_CASCADES) {
+            if let Some(t) = cube.transform(layer as u32) {
+                raw.uv_from_world[layer] = cols(&t.uv_from_world);
+            }
+            let scale = face.uv_scale_in_layer(side);
+            let row = &mut raw.layer_uv_scale[layer / 2];
+            row[2 * (layer % 2)] = scale.x;
+            row[2 * (layer % 2) + 1] = scale.y;
+        }
+        raw.count = cube.layers().min(MAX_CASCADES as u32);
+        raw.reversed_z = u32::from(cube.reversed_z);
+        raw.select_by_projection = 1;
+        raw
+    }
+
     /// Selection by projection (the finest map containing the point) instead of by
     /// view depth, with a margin of `margin_texels` texels of a `resolution²` map,
     /// as `CascadeSet::select_by_projection`. A non-finite or negative margin, or a
@@ -139,7 +177,7 @@ impl CascadeShadowRaw {
 impl ToRaw for CascadeSet {
     type Raw = CascadeShadowRaw;
     fn to_raw(&self) -> CascadeShadowRaw {
-        let mut raw = CascadeShadowRaw::zeroed();
+        let mut raw = CascadeShadowRaw::unscaled();
         let depths = self.splits.depths();
         for (i, c) in self.cascades.iter().enumerate().take(MAX_CASCADES) {
             raw.uv_from_world[i] = cols(&c.transform.uv_from_world);
@@ -163,6 +201,25 @@ impl ToRaw for CascadeSet {
 #[must_use]
 pub fn cascade_layers(set: &CascadeSet) -> Vec<MatrixShadowRaw> {
     set.cascades.iter().map(|c| c.transform.to_raw()).collect()
+}
+
+/// The per-layer depth-pass blocks of a cube map: one [`MatrixShadowRaw`] per kept
+/// face (layer `i` = face `i`), each face drawn into the top-left corner of a layer
+/// of the largest face's side (`CubeFace::clip_from_world_in_layer`), so faces
+/// sized by need keep their own texel density; with equal faces every face fills
+/// its layer. Render at `CubeMap::largest_side` texels per layer for the fit's
+/// densities.
+#[must_use]
+pub fn cube_layers(cube: &CubeMap) -> Vec<MatrixShadowRaw> {
+    let side = cube.largest_side();
+    (0..cube.layers())
+        .zip(&cube.faces)
+        .filter_map(|(layer, face)| {
+            let mut raw = cube.transform(layer)?.to_raw();
+            raw.clip_from_world = cols(&face.clip_from_world_in_layer(side));
+            Some(raw)
+        })
+        .collect()
 }
 
 /// A depth-pass `clip_from_world` that sends every vertex to `(0, 0, -1, 1)`,
@@ -197,7 +254,7 @@ impl CascadeShadowRaw {
     /// lookup reports the point as not covered).
     #[must_use]
     pub fn from_warped(set: &WarpedCascades, view_from_world: Mat4) -> Self {
-        let mut raw = Self::zeroed();
+        let mut raw = Self::unscaled();
         for (i, c) in set.cascades.iter().enumerate().take(MAX_CASCADES) {
             if let Some(s) = &c.shadow {
                 raw.uv_from_world[i] = cols(&s.transform.uv_from_world);
@@ -241,6 +298,10 @@ pub struct ParaboloidLayerRaw {
     /// [`ParaboloidLayerRaw::new`], the depth pass writes its map resolution there
     /// (the vertex shader snaps to its subpixel grid); `z`, `w`: 0.
     pub side: [f32; 4],
+    /// The side's warp tables in the pass's table buffer (RTW over the side,
+    /// [`warped_paraboloid`]): `u` offset, `u` texels, `v` offset, `v` texels; all 0
+    /// (no warp) from [`ParaboloidLayerRaw::new`].
+    pub warp: [u32; 4],
 }
 
 impl ParaboloidLayerRaw {
@@ -250,6 +311,7 @@ impl ParaboloidLayerRaw {
         Self {
             map: ToRaw::to_raw(map),
             side: [side.layer() as f32, 0.0, 0.0, 0.0],
+            warp: [0; 4],
         }
     }
 }
@@ -263,6 +325,71 @@ pub fn paraboloid_layers(map: &ParaboloidMap) -> Vec<ParaboloidLayerRaw> {
         v.push(ParaboloidLayerRaw::new(map, Side::Back));
     }
     v
+}
+
+/// The lookup of a paraboloid map: WGSL `ParaboloidLookup`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct ParaboloidLookupRaw {
+    /// The map.
+    pub map: ParaboloidUniform,
+    /// Per side (front, back): its warp tables, as [`ParaboloidLayerRaw::warp`].
+    pub warp: [[u32; 4]; 2],
+}
+
+impl ParaboloidLookupRaw {
+    /// The lookup of an unwarped map (DPSM, IPSM).
+    #[must_use]
+    pub fn new(map: &ParaboloidMap) -> Self {
+        Self {
+            map: ToRaw::to_raw(map),
+            warp: [[0; 4]; 2],
+        }
+    }
+}
+
+/// RTW over the sides of a paraboloid map (`point_rtw`): the depth pass's blocks, the
+/// lookup's block and the one table buffer both read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WarpedParaboloid {
+    /// One block per layer (front, then back for a dual map).
+    pub layers: Vec<ParaboloidLayerRaw>,
+    /// The lookup.
+    pub lookup: ParaboloidLookupRaw,
+    /// The tables: front `u`, front `v`, then back `u`, back `v` (one zero when
+    /// there are none).
+    pub tables: Vec<f32>,
+}
+
+/// The blocks and tables of a paraboloid map whose sides are warped by `front` and
+/// (for a dual map) `back`; a side without tables is not warped.
+#[must_use]
+pub fn warped_paraboloid(
+    map: &ParaboloidMap,
+    front: Option<&WarpMaps>,
+    back: Option<&WarpMaps>,
+) -> WarpedParaboloid {
+    let mut layers = paraboloid_layers(map);
+    let mut lookup = ParaboloidLookupRaw::new(map);
+    let mut tables = Vec::new();
+    for (i, warps) in [front, back].into_iter().enumerate().take(layers.len()) {
+        let Some(warps) = warps else { continue };
+        let (x, y) = (warps.x_table(), warps.y_table());
+        let at = tables.len() as u32;
+        let warp = [at, x.len() as u32, at + x.len() as u32, y.len() as u32];
+        tables.extend_from_slice(x);
+        tables.extend_from_slice(y);
+        layers[i].warp = warp;
+        lookup.warp[i] = warp;
+    }
+    if tables.is_empty() {
+        tables.push(0.0);
+    }
+    WarpedParaboloid {
+        layers,
+        lookup,
+        tables,
+    }
 }
 
 /// Rectilinear texture warping: WGSL `RtwShadow`. The tables themselves travel in a

@@ -1,11 +1,12 @@
-//! The GPU depth pass of cube shadow maps (the matrix pass, one layer per kept face)
-//! matches the CPU reference rasterizer of `shadowmap-eval`, with the tolerance of the
+//! The GPU depth pass of cube shadow maps (the matrix pass, one layer per kept face,
+//! faces sized by need in their layers' corners) matches the CPU reference
+//! rasterizer of `shadowmap-eval`, with the tolerance of the
 //! other depth tests: at most 0.1% of texels differ by more than 1e-4 in depth; and
 //! a frame rendered through `render_shadow` (depth pass and face lookup) shadows what
 //! a DPSM of the same light shadows.
 
 use glam::Vec3;
-use shadowmap::paraboloid::{CubeMap, CubeOptions};
+use shadowmap::paraboloid::{CubeMap, CubeOptions, FaceSizes};
 use shadowmap::{FitInput, Technique, fit};
 use shadowmap_eval::raster::{DepthMap, MatrixProjector, RasterOptions, rasterize_depth};
 use shadowmap_eval::scene::Scene;
@@ -29,14 +30,11 @@ fn blocks(cube: &CubeMap) -> Vec<shadowmap_wgpu::uniforms::MatrixShadowRaw> {
         .collect()
 }
 
-#[test]
-fn cube_faces_match_the_cpu_rasterizer() {
-    let Some(ctx) = shadowmap_wgpu::context::test_context("cube_faces_match_the_cpu_rasterizer")
-    else {
-        return;
-    };
+/// The city block, its triangles, a camera over it and a lamp among its buildings,
+/// inside the view (several faces kept).
+fn lamp_among_buildings() -> (Scene, Vec<[Vec3; 3]>, Camera, Light) {
     let scene = Scene::city_block(1);
-    let tris: Vec<[Vec3; 3]> = scene
+    let tris = scene
         .mesh
         .triangles()
         .map(|t| t.map(glam::DVec3::as_vec3))
@@ -48,16 +46,45 @@ fn cube_faces_match_the_cpu_rasterizer() {
         Projection::perspective(60f32.to_radians(), 4.0 / 3.0, 1.0, 300.0),
     )
     .unwrap();
-    // A lamp among the buildings, inside the view: several faces kept.
     let lamp = Light::Point {
         position: Vec3::new(3.0, 30.0, -2.0),
         range: 400.0,
     };
+    (scene, tris, camera, lamp)
+}
+
+/// The matrix depth pass of `raws` over `tris`, read back.
+fn gpu_depth(
+    ctx: &shadowmap_wgpu::GpuContext,
+    tris: &[[Vec3; 3]],
+    desc: &DepthPassDesc,
+    raws: &[shadowmap_wgpu::uniforms::MatrixShadowRaw],
+) -> Vec<f32> {
+    ctx.scoped(|ctx| {
+        let mesh = MeshBuffers::from_triangles(ctx, tris)?;
+        let mut pass = ShadowDepthPass::new(ctx, desc)?;
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        pass.encode(ctx, &mut encoder, &[&mesh], &DepthUniforms::Matrix(raws))?;
+        ctx.queue.submit([encoder.finish()]);
+        pass.readback_depth(ctx)
+    })
+    .expect("GPU depth pass")
+}
+
+#[test]
+fn cube_faces_match_the_cpu_rasterizer() {
+    let Some(ctx) = shadowmap_wgpu::context::test_context("cube_faces_match_the_cpu_rasterizer")
+    else {
+        return;
+    };
+    let (scene, tris, camera, lamp) = lamp_among_buildings();
     let bounds = SceneBounds::whole(scene.bounds().unwrap());
+    // One layer per face: faces of one side.
+    let equal = CubeOptions::default().with_sizes(FaceSizes::Equal);
     for options in [
-        CubeOptions::default(),
-        CubeOptions::default().with_reversed_z(true),
-        CubeOptions::default().with_focused(false),
+        equal,
+        equal.with_reversed_z(true),
+        equal.with_focused(false),
     ] {
         let cube = CubeMap::fit(&lamp, &camera, None, &bounds, &options).unwrap();
         let layers = cube.layers();
@@ -66,16 +93,7 @@ fn cube_faces_match_the_cpu_rasterizer() {
         let desc = DepthPassDesc::new(DepthTechnique::Matrix, RES)
             .with_layers(layers)
             .with_reversed_z(cube.reversed_z);
-        let gpu = ctx
-            .scoped(|ctx| {
-                let mesh = MeshBuffers::from_triangles(ctx, &tris)?;
-                let mut pass = ShadowDepthPass::new(ctx, &desc)?;
-                let mut encoder = ctx.device.create_command_encoder(&Default::default());
-                pass.encode(ctx, &mut encoder, &[&mesh], &DepthUniforms::Matrix(&raws))?;
-                ctx.queue.submit([encoder.finish()]);
-                pass.readback_depth(ctx)
-            })
-            .expect("GPU depth pass");
+        let gpu = gpu_depth(&ctx, &tris, &desc, &raws);
         let matrices = cube
             .faces
             .iter()
@@ -168,10 +186,11 @@ fn cube_frames_shadow_what_a_dpsm_shadows() {
             .values
     };
     let dpsm = mask(&Technique::Dpsm(Default::default()));
+    let equal = CubeOptions::default().with_sizes(FaceSizes::Equal);
     for cube in [
-        Technique::CubeMaps(CubeOptions::default()),
-        Technique::CubeMaps(CubeOptions::default().with_reversed_z(true)),
-        Technique::CubeMaps(CubeOptions::default().with_focused(false)),
+        Technique::CubeMaps(equal),
+        Technique::CubeMaps(equal.with_reversed_z(true)),
+        Technique::CubeMaps(equal.with_focused(false)),
     ] {
         let values = mask(&cube);
         let count = |v: MaskValue| values.iter().filter(|g| **g == v).count();
@@ -199,4 +218,52 @@ fn cube_frames_shadow_what_a_dpsm_shadows() {
             both.len()
         );
     }
+}
+
+/// Faces sized by need (different sides): each drawn into the top-left corner of a
+/// layer of the largest face's side, its corner matches the CPU rasterizer's map of
+/// the face at its own size (the fit's texel density), within the tolerance of the
+/// other depth tests. (Whole frames of them, lookup included, are compared with the
+/// CPU reference in `gpu_volume`, as the report's `cube`.)
+#[test]
+fn cube_faces_of_different_sides_match_the_cpu_rasterizer() {
+    let Some(ctx) = shadowmap_wgpu::context::test_context(
+        "cube_faces_of_different_sides_match_the_cpu_rasterizer",
+    ) else {
+        return;
+    };
+    let (scene, tris, camera, lamp) = lamp_among_buildings();
+    let bounds = SceneBounds::whole(scene.bounds().unwrap());
+    let options = CubeOptions::default()
+        .with_sizes(FaceSizes::ByNeed)
+        .with_texel_budget(384 * 384);
+    let cube = CubeMap::fit(&lamp, &camera, None, &bounds, &options).unwrap();
+    assert!(!cube.has_equal_faces());
+    let side = cube.largest_side();
+    let layers = cube.layers();
+    let raws = shadowmap_wgpu::uniforms::cube_layers(&cube);
+    let desc = DepthPassDesc::new(DepthTechnique::Matrix, side).with_layers(layers);
+    let gpu = gpu_depth(&ctx, &tris, &desc, &raws);
+    let n = (side * side) as usize;
+    let (mut differing, mut compared) = (0, 0);
+    for (layer, face) in cube.faces.iter().enumerate() {
+        let [w, h] = face.size;
+        let projector = MatrixProjector::new(vec![face.clip_from_world.as_dmat4()], false);
+        let raster = RasterOptions::default().with_size(w, h);
+        let cpu: DepthMap = rasterize_depth(&scene.mesh, &projector, &raster).unwrap();
+        let corner = &gpu[layer * n..(layer + 1) * n];
+        for row in 0..h as usize {
+            for col in 0..w as usize {
+                let g = corner[row * side as usize + col];
+                let c = cpu.depth[row * w as usize + col];
+                differing += usize::from((g - c).abs() > 1e-4);
+                compared += 1;
+            }
+        }
+    }
+    let fraction = differing as f64 / compared as f64;
+    eprintln!(
+        "cube by need (side {side}): {differing} of {compared} texels differ ({fraction:.5})"
+    );
+    assert!(fraction <= 1e-3, "{differing} of {compared} texels differ");
 }

@@ -1,23 +1,34 @@
-//! RTW caster refinement on the GPU (`GpuRefine` + `ShadowDepthPass::encode_refined`)
-//! against the CPU reference subdivision (`subdivide_for_rtw` + `encode`): the same
-//! triangles, the same depth map within the tolerance of the other depth tests (at
-//! most 0.1% of texels differ by more than 1e-4), no cracks on a closed mesh, and a
-//! coarser mesh, never a truncated one, when the capacity is short.
+//! Caster refinement on the GPU (`GpuRefine` + `ShadowDepthPass::encode_refined`)
+//! against the CPU reference subdivisions (+ `encode`), rendered by the same depth
+//! pass: RTW's (`subdivide_for_rtw`: the same triangles), the paraboloid grid of
+//! `subdivide_triangles` (DPSM, IPSM) and RTW over paraboloid sides
+//! (`subdivide_for_rtw_clipped` at the side's plane, `point_rtw`): piece counts
+//! within 0.5% (an edge whose error is within `f32` rounding of its bound may split
+//! differently) and the same
+//! depth map within the tolerance of the other depth tests (at most 0.1% of texels
+//! differ by more than 1e-4); no cracks on a closed mesh; a coarser mesh, never a
+//! truncated one, when the capacity is short; casters behind a perspective light
+//! dropped both ways.
 
 use std::collections::HashSet;
 
 use glam::{Mat4, Vec2, Vec3};
+use shadowmap::paraboloid::{
+    IpsmOptions, IpsmPlan, MapOptions, ParaboloidMap, Side, SubdivisionOptions, subdivide_triangles,
+};
 use shadowmap::{FitInput, Technique, fit};
 use shadowmap_eval::scene::Scene;
-use shadowmap_frustum::{Camera, Light, LightDirection, Projection, ShadowTransform};
-use shadowmap_rtw::{ImportanceMap, RtwShadow, WarpMaps, WarpOptions, forward_warp};
+use shadowmap_frustum::{Camera, DepthBounds, Light, LightDirection, Projection, ShadowTransform};
+use shadowmap_rtw::{
+    ImportanceMap, RtwShadow, WarpMaps, WarpOptions, forward_warp, subdivide_for_rtw_clipped,
+};
 use shadowmap_warp::SceneBounds;
 use shadowmap_wgpu::depth::{
     DepthPassDesc, DepthTechnique, DepthUniforms, MeshBuffers, RtwSubdivision, ShadowDepthPass,
     subdivide_for_rtw,
 };
 use shadowmap_wgpu::refine::{GpuRefine, RefineOptions, RefineStats};
-use shadowmap_wgpu::uniforms::{RtwShadowRaw, ToRaw};
+use shadowmap_wgpu::uniforms::{RtwShadowRaw, ToRaw, paraboloid_layers, warped_paraboloid};
 use shadowmap_wgpu::{BackendError, GpuContext};
 use wgpu::util::DeviceExt;
 
@@ -78,23 +89,32 @@ struct Frame {
     refined: Vec<[Vec3; 3]>,
 }
 
-/// Renders `cpu_mesh` with `encode` and `casters` refined on the GPU with
-/// `encode_refined`, in one submission, from the same uniforms.
+/// Renders `cpu_meshes` (one per layer) with `encode` and `casters` refined on the
+/// GPU with `encode_refined`, in one submission, from the same uniforms.
 fn render_both(
     ctx: &GpuContext,
     uniforms: &DepthUniforms<'_>,
-    cpu_mesh: &[[Vec3; 3]],
+    cpu_meshes: &[&[[Vec3; 3]]],
     casters: &[[Vec3; 3]],
     options: &RefineOptions,
 ) -> Frame {
+    let technique = match uniforms {
+        DepthUniforms::Rtw { .. } | DepthUniforms::RtwGpuTables { .. } => DepthTechnique::Rtw,
+        _ => DepthTechnique::Paraboloid,
+    };
     ctx.scoped(|ctx| {
-        let mesh = MeshBuffers::from_triangles(ctx, cpu_mesh)?;
+        let meshes = cpu_meshes
+            .iter()
+            .map(|m| MeshBuffers::from_triangles(ctx, m))
+            .collect::<Result<Vec<_>, _>>()?;
+        let refs: Vec<&MeshBuffers> = meshes.iter().collect();
         let mut refine = GpuRefine::new(ctx, casters, options)?;
-        let desc = DepthPassDesc::new(DepthTechnique::Rtw, RES);
+        let layers = u32::try_from(refs.len()).unwrap();
+        let desc = DepthPassDesc::new(technique, RES).with_layers(layers);
         let mut cpu_pass = ShadowDepthPass::new(ctx, &desc)?;
         let mut gpu_pass = ShadowDepthPass::new(ctx, &desc)?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        cpu_pass.encode(ctx, &mut encoder, &[&mesh], uniforms)?;
+        cpu_pass.encode(ctx, &mut encoder, &refs, uniforms)?;
         refine.encode(ctx, &mut encoder, uniforms)?;
         gpu_pass.encode_refined(ctx, &mut encoder, &refine, uniforms)?;
         ctx.queue.submit([encoder.finish()]);
@@ -117,8 +137,7 @@ fn key(t: &[Vec3; 3]) -> [u32; 9] {
 }
 
 /// Asserts the GPU pieces are the CPU's (up to `f32` decisions within an ulp of the
-/// bound: at most 0.5% of them differ) and the two maps agree on all but 0.1% of
-/// texels (1e-4 in depth), with something drawn.
+/// bound: at most 0.5% of them differ) and the two maps agree.
 fn assert_same(name: &str, frame: &Frame, cpu_mesh: &[[Vec3; 3]]) {
     let cpu: HashSet<[u32; 9]> = cpu_mesh.iter().map(key).collect();
     let shared = frame
@@ -133,6 +152,27 @@ fn assert_same(name: &str, frame: &Frame, cpu_mesh: &[[Vec3; 3]]) {
         shared as f64 >= 0.995 * cpu_n.max(gpu_n) as f64,
         "{name}: meshes differ"
     );
+    assert_maps_agree(name, frame);
+}
+
+/// Asserts each layer's piece count is the CPU's within 0.5% (the paraboloid grid's
+/// vertices are computed in `f32` on the GPU, in `f64` on the CPU, so pieces are
+/// compared by count) and the two maps agree.
+fn assert_counts(name: &str, frame: &Frame, cpu_meshes: &[&[[Vec3; 3]]]) {
+    for (layer, mesh) in cpu_meshes.iter().enumerate() {
+        let (gpu, cpu) = (frame.stats.layer_triangles[layer] as usize, mesh.len());
+        eprintln!("{name} layer {layer}: GPU {gpu} pieces, CPU {cpu}");
+        assert!(
+            gpu.abs_diff(cpu) as f64 <= 5e-3 * cpu as f64,
+            "{name} layer {layer}: GPU {gpu}, CPU {cpu} pieces"
+        );
+    }
+    assert_maps_agree(name, frame);
+}
+
+/// Asserts the two maps agree on all but 0.1% of texels (1e-4 in depth), with
+/// something drawn.
+fn assert_maps_agree(name: &str, frame: &Frame) {
     let drawn = frame.gpu_depth.iter().filter(|d| **d < 1.0).count();
     assert!(
         drawn > frame.gpu_depth.len() / 20,
@@ -177,7 +217,7 @@ fn gpu_refinement_draws_the_cpu_subdivision() {
         raw: shadow.to_raw(),
         tables: &tables,
     };
-    let frame = render_both(&ctx, &from_slice, &cpu_mesh, &casters, &options);
+    let frame = render_both(&ctx, &from_slice, &[&cpu_mesh], &casters, &options);
     assert!(!frame.stats.overflowed);
     assert_eq!(frame.stats.levels, frame.stats.requested_levels);
     assert_same("tables from a slice", &frame, &cpu_mesh);
@@ -194,7 +234,7 @@ fn gpu_refinement_draws_the_cpu_subdivision() {
         raw: shadow.to_raw(),
         tables: &buffer,
     };
-    let frame = render_both(&ctx, &from_buffer, &cpu_mesh, &casters, &options);
+    let frame = render_both(&ctx, &from_buffer, &[&cpu_mesh], &casters, &options);
     assert_same("tables in a GPU buffer", &frame, &cpu_mesh);
 }
 
@@ -222,7 +262,7 @@ fn a_short_capacity_refines_coarser_and_drops_nothing() {
         tables: &tables,
     };
     // Learn the level that fits, then compare with the CPU capped at that level.
-    let probe = render_both(&ctx, &uniforms, &casters, &casters, &options);
+    let probe = render_both(&ctx, &uniforms, &[&casters], &casters, &options);
     let stats = probe.stats;
     eprintln!("{stats:?}");
     assert!(stats.overflowed, "{} triangles fit", capacity);
@@ -231,7 +271,7 @@ fn a_short_capacity_refines_coarser_and_drops_nothing() {
     let mut cpu_mesh = Vec::new();
     let capped = subdivision.with_max_segments(1 << stats.levels);
     subdivide_for_rtw(&shadow, &casters, &capped, &mut cpu_mesh);
-    let frame = render_both(&ctx, &uniforms, &cpu_mesh, &casters, &options);
+    let frame = render_both(&ctx, &uniforms, &[&cpu_mesh], &casters, &options);
     assert_eq!(frame.stats, stats);
     assert_same("capped", &frame, &cpu_mesh);
 }
@@ -317,7 +357,7 @@ fn a_closed_box_covers_its_silhouette_without_cracks() {
     };
     let subdivision = RtwSubdivision::default().with_resolution(RES);
     let options = RefineOptions::default().with_subdivision(subdivision);
-    let frame = render_both(&ctx, &uniforms, &casters, &casters, &options);
+    let frame = render_both(&ctx, &uniforms, &[&casters], &casters, &options);
     assert!(
         frame.stats.triangles > 4 * casters.len() as u32,
         "{:?}",
@@ -391,4 +431,238 @@ fn bad_input_is_a_typed_error() {
             .encode_refined(&ctx, &mut encoder, &refine, &matrix)
             .is_err()
     );
+}
+
+/// A DPSM over the city block, the front side facing down.
+fn dpsm() -> ParaboloidMap {
+    ParaboloidMap::dual(
+        Vec3::new(5.0, 45.0, 10.0),
+        Vec3::new(0.1, -1.0, 0.05),
+        0.5,
+        600.0,
+        &MapOptions::default(),
+    )
+    .unwrap()
+}
+
+/// IPSM's map for a view of the block with the lamp behind and above the camera,
+/// outside the truncated frustum: one cut paraboloid.
+fn ipsm() -> ParaboloidMap {
+    let camera = Camera::look_at(
+        Vec3::new(10.0, 18.0, 120.0),
+        Vec3::new(0.0, 4.0, 0.0),
+        Vec3::Y,
+        Projection::perspective(1.0, 16.0 / 9.0, 1.0, 500.0),
+    )
+    .unwrap();
+    let lamp = Light::Point {
+        position: Vec3::new(-30.0, 80.0, 220.0),
+        range: 600.0,
+    };
+    let bounds = DepthBounds {
+        min: 5.0,
+        max: 250.0,
+    };
+    let map = IpsmPlan::new(&lamp, &camera, Some(bounds), &IpsmOptions::default())
+        .unwrap()
+        .map;
+    assert_eq!(map.layers(), 1, "a single cut paraboloid");
+    map
+}
+
+/// Each side's CPU grid subdivision of the city block.
+fn cpu_grid(map: &ParaboloidMap, options: &SubdivisionOptions) -> Vec<Vec<[Vec3; 3]>> {
+    let casters = city();
+    [Side::Front, Side::Back]
+        .into_iter()
+        .take(map.layers() as usize)
+        .map(|side| {
+            let mut out = Vec::new();
+            subdivide_triangles(map, side, &casters, options, &mut out).unwrap();
+            out
+        })
+        .collect()
+}
+
+fn slices(meshes: &[Vec<[Vec3; 3]>]) -> Vec<&[[Vec3; 3]]> {
+    meshes.iter().map(Vec::as_slice).collect()
+}
+
+#[test]
+fn gpu_grid_refinement_draws_the_cpu_subdivision() {
+    let Some(ctx) =
+        shadowmap_wgpu::context::test_context("gpu_grid_refinement_draws_the_cpu_subdivision")
+    else {
+        return;
+    };
+    let sub = SubdivisionOptions::default().with_resolution(RES);
+    let options = RefineOptions::default().with_paraboloid(sub);
+    let casters = city();
+    for (name, map) in [("dpsm", dpsm()), ("ipsm", ipsm())] {
+        let cpu = cpu_grid(&map, &sub);
+        let pieces: usize = cpu.iter().map(Vec::len).sum();
+        assert!(
+            pieces > 2 * casters.len() * cpu.len(),
+            "{name}: the paraboloid splits casters ({pieces} pieces)"
+        );
+        let layers = paraboloid_layers(&map);
+        let uniforms = DepthUniforms::Paraboloid(&layers);
+        let frame = render_both(&ctx, &uniforms, &slices(&cpu), &casters, &options);
+        assert!(!frame.stats.overflowed, "{name}: {:?}", frame.stats);
+        assert_eq!(frame.stats.levels, 4, "{name}: 16 segments, 2^4");
+        assert_counts(name, &frame, &slices(&cpu));
+    }
+}
+
+#[test]
+fn a_short_capacity_caps_the_grid_and_drops_nothing() {
+    let Some(ctx) =
+        shadowmap_wgpu::context::test_context("a_short_capacity_caps_the_grid_and_drops_nothing")
+    else {
+        return;
+    };
+    let map = dpsm();
+    let casters = city();
+    let sub = SubdivisionOptions::default().with_resolution(RES);
+    let capacity = 4 * casters.len() as u32;
+    let options = RefineOptions::default()
+        .with_paraboloid(sub)
+        .with_capacity(capacity);
+    let layers = paraboloid_layers(&map);
+    let uniforms = DepthUniforms::Paraboloid(&layers);
+    // Learn the cap that fits, then compare with the CPU capped there.
+    let full = cpu_grid(&map, &sub);
+    let probe = render_both(&ctx, &uniforms, &slices(&full), &casters, &options);
+    let stats = probe.stats;
+    eprintln!("{stats:?}");
+    assert!(stats.overflowed && stats.levels < stats.requested_levels);
+    assert!(stats.triangles <= capacity);
+    assert!(
+        stats
+            .layer_triangles
+            .iter()
+            .all(|&n| n >= casters.len() as u32)
+    );
+    let capped = cpu_grid(&map, &sub.with_max_segments(1 << stats.levels));
+    let frame = render_both(&ctx, &uniforms, &slices(&capped), &casters, &options);
+    assert_eq!(frame.stats, stats);
+    assert_counts("capped grid", &frame, &slices(&capped));
+}
+
+/// Tables with a strong warp over `64 x 64` cells, the peaks moved by `shift`.
+fn square_warps(shift: f32) -> WarpMaps {
+    let mut importance = ImportanceMap::new(64, 64).unwrap();
+    importance.splat(Vec2::new(0.5, 0.6 - shift), 10.0).unwrap();
+    importance.splat(Vec2::new(0.3 + shift, 0.2), 3.0).unwrap();
+    importance.splat(Vec2::new(0.8, 0.9), 1.0).unwrap();
+    let mut warps = WarpMaps::new(64, 64).unwrap();
+    warps
+        .build(&importance, &WarpOptions::default().with_blur_radius(3))
+        .unwrap();
+    warps
+}
+
+#[test]
+fn gpu_rtw_over_paraboloid_sides_draws_the_cpu_subdivision() {
+    let Some(ctx) = shadowmap_wgpu::context::test_context(
+        "gpu_rtw_over_paraboloid_sides_draws_the_cpu_subdivision",
+    ) else {
+        return;
+    };
+    // Both sides of a DPSM, and IPSM's single cut paraboloid (zoomed: its disc
+    // spans more than the map, so edges need more pieces to cross it).
+    for (name, map) in [("dpsm", dpsm()), ("ipsm", ipsm())] {
+        rtw_over_paraboloid(&ctx, name, &map);
+    }
+}
+
+fn rtw_over_paraboloid(ctx: &shadowmap_wgpu::GpuContext, name: &str, map: &ParaboloidMap) {
+    let (front, back) = (square_warps(0.0), square_warps(0.1));
+    let sides = [(Side::Front, &front), (Side::Back, &back)];
+    let sides = &sides[..map.layers() as usize];
+    let sub = RtwSubdivision::default().with_resolution(RES);
+    let casters = city();
+    let cpu: Vec<Vec<[Vec3; 3]>> = sides
+        .iter()
+        .map(|(side, warps)| {
+            // As eval's reference: cut at the side's plane, with enough pieces an
+            // edge to cross the side's disc.
+            let uv = |p: Vec3| map.project(p, *side).map(|s| s.uv);
+            let plane = |p: Vec3| map.plane_distance(p, *side);
+            let cells = warps.x_table().len().max(warps.y_table().len());
+            let rule = sub.with_segments_for_extent(1.0 / f64::from(map.zoom), cells);
+            let mut out = Vec::new();
+            subdivide_for_rtw_clipped(uv, &[&plane], warps, &casters, &rule, &mut out);
+            out
+        })
+        .collect();
+    assert!(cpu[0].len() > 2 * casters.len(), "the warp splits casters");
+    let warped = warped_paraboloid(map, Some(&front), (map.layers() > 1).then_some(&back));
+    let uniforms = DepthUniforms::WarpedParaboloid {
+        layers: &warped.layers,
+        tables: &warped.tables,
+    };
+    let options = RefineOptions::default().with_subdivision(sub);
+    let frame = render_both(ctx, &uniforms, &slices(&cpu), &casters, &options);
+    assert!(!frame.stats.overflowed, "{:?}", frame.stats);
+    assert_counts(name, &frame, &slices(&cpu));
+}
+
+/// RTW over a spot light's perspective fit with the light among the buildings:
+/// casters with a vertex behind the light's plane are dropped by the CPU subdivision
+/// and by the GPU refinement alike, and the maps agree.
+#[test]
+fn a_perspective_base_drops_casters_behind_the_light_both_ways() {
+    let Some(ctx) = shadowmap_wgpu::context::test_context(
+        "a_perspective_base_drops_casters_behind_the_light_both_ways",
+    ) else {
+        return;
+    };
+    let camera = Camera::look_at(
+        Vec3::new(0.0, 30.0, 80.0),
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::Y,
+        Projection::perspective(1.0, 4.0 / 3.0, 1.0, 300.0),
+    )
+    .unwrap();
+    let spot = Light::Spot {
+        position: Vec3::new(0.0, 12.0, 10.0),
+        direction: Vec3::new(0.2, -0.6, -1.0),
+        half_angle: 0.8,
+        range: 300.0,
+    };
+    let focus = SceneBounds::whole(Scene::city_block(1).bounds().unwrap());
+    let input = FitInput::new(&camera, &spot, focus, u64::from(RES * RES));
+    let base = *fit(&Technique::SpotFit { reversed_z: false }, &input)
+        .unwrap()
+        .transform()
+        .unwrap();
+    let warps = warps();
+    let shadow = RtwShadow {
+        base,
+        warps: &warps,
+    };
+    let casters = city();
+    let behind = casters
+        .iter()
+        .filter(|t| {
+            t.iter()
+                .any(|p| (base.uv_from_world * p.extend(1.0)).w <= 0.0)
+        })
+        .count();
+    assert!(
+        behind > 100,
+        "only {behind} casters cross the light's plane"
+    );
+    let subdivision = RtwSubdivision::default().with_resolution(RES);
+    let mut cpu_mesh = Vec::new();
+    subdivide_for_rtw(&shadow, &casters, &subdivision, &mut cpu_mesh);
+    let options = RefineOptions::default().with_subdivision(subdivision);
+    let tables = RtwShadowRaw::tables(&shadow);
+    let uniforms = DepthUniforms::Rtw {
+        raw: shadow.to_raw(),
+        tables: &tables,
+    };
+    let frame = render_both(&ctx, &uniforms, &[&cpu_mesh], &casters, &options);
+    assert_same("spot base", &frame, &cpu_mesh);
 }

@@ -6,11 +6,18 @@
 //!
 //! Samples whose base `uv` lies within 1e-3 of a cell border are left out of the
 //! G-buffer: there the GPU (`f32`) and the CPU (`f64`) may rightly pick neighbouring
-//! cells.
+//! cells. The G-buffer rendered on the GPU (`RtwGBufferPass`) holds the ray-traced
+//! surfaces of `shadowmap_eval`'s G-buffer away from silhouettes.
 
 use glam::{DVec3, Mat4, Vec3};
+use shadowmap_eval::bvh::Bvh;
+use shadowmap_eval::mask::GBuffer;
+use shadowmap_eval::scene::Scene;
+use shadowmap_frustum::{Camera, Projection};
 use shadowmap_frustum::{LightDirection, ShadowTransform, projection};
 use shadowmap_rtw::{EyeSample, ImportanceMap, ImportanceOptions, WarpMaps, WarpOptions};
+use shadowmap_wgpu::depth::MeshBuffers;
+use shadowmap_wgpu::gbuffer::RtwGBufferPass;
 use shadowmap_wgpu::rtw::{GpuRtw, RtwGBufferTextures};
 use shadowmap_wgpu::{BackendError, GpuContext, context::test_context};
 
@@ -266,7 +273,7 @@ fn gpu_tables_equal_cpu_tables_on_random_gbuffers() {
         let mut rng = Rng(0x5eed_0f2a_7c00_u64);
         let importance = ImportanceOptions::default();
         // (map size, G-buffer size, warp options, perspective base)
-        let cases: [(MapSize, MapSize, WarpOptions, bool); 5] = [
+        let cases: [(MapSize, MapSize, WarpOptions, bool); 6] = [
             ((64, 64), (48, 40), WarpOptions::default(), false),
             (
                 (100, 37),
@@ -291,6 +298,15 @@ fn gpu_tables_equal_cpu_tables_on_random_gbuffers() {
                 (64, 32),
                 WarpOptions::default().with_blur_radius(3).with_floor(1e-5),
                 false,
+            ),
+            // One lane past the build's 256-wide workgroup and the collapse's 64, a
+            // G-buffer one texel past a 16x16 splat workgroup each way, with the
+            // options of the NVIDIA report.
+            (
+                (257, 65),
+                (17, 17),
+                WarpOptions::default().with_blur_radius(5).with_floor(0.001),
+                true,
             ),
         ];
         for (map, gbuffer, warp, perspective) in cases {
@@ -416,4 +432,69 @@ fn gpu_rtw_rejects_bad_input() {
         RtwGBufferTextures::from_samples(&ctx, 2, 2, &[None], None),
         Err(BackendError::InvalidInput(_))
     ));
+}
+
+/// The G-buffer pass against the ray-traced G-buffer of the same camera: the same
+/// pixels hold a sample (all but silhouette pixels), at the same position and eye
+/// distance (to 1e-3 of the distance) with the same face normal up to sign.
+#[test]
+fn the_gpu_gbuffer_is_the_ray_traced_one() {
+    let Some(ctx) = test_context("the_gpu_gbuffer_is_the_ray_traced_one") else {
+        return;
+    };
+    let scene = Scene::city_block(1);
+    let camera = Camera::look_at(
+        Vec3::new(10.0, 18.0, 120.0),
+        Vec3::new(0.0, 4.0, 0.0),
+        Vec3::Y,
+        Projection::perspective(1.0, 16.0 / 9.0, 1.0, 500.0),
+    )
+    .unwrap();
+    let (width, height) = (160, 90);
+    let triangles: Vec<[Vec3; 3]> = scene
+        .mesh
+        .triangles()
+        .map(|t| t.map(DVec3::as_vec3))
+        .collect();
+    let (positions, normals) = ctx
+        .scoped(|ctx| {
+            let mesh = MeshBuffers::from_triangles(ctx, &triangles)?;
+            let mut pass = RtwGBufferPass::new(ctx, width, height, camera.reversed_z)?;
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            pass.encode(ctx, &mut encoder, &mesh, &camera)?;
+            ctx.queue.submit([encoder.finish()]);
+            pass.read(ctx)
+        })
+        .expect("G-buffer pass");
+    let traced = GBuffer::trace(&Bvh::build(&scene.mesh).unwrap(), &camera, width, height).unwrap();
+    let eye = camera.eye().as_dvec3();
+    let (mut both, mut flags_differ, mut far, mut turned) = (0, 0, 0, 0);
+    for ((p, n), surface) in positions.iter().zip(&normals).zip(&traced.surfaces) {
+        match (n.w >= 0.5, surface) {
+            (true, Some(s)) => {
+                both += 1;
+                let distance = s.position.distance(eye);
+                let gpu = p.truncate().as_dvec3();
+                if gpu.distance(s.position) > 1e-3 * distance
+                    || (f64::from(p.w) - distance).abs() > 1e-3 * distance
+                {
+                    far += 1;
+                }
+                if n.truncate().as_dvec3().dot(s.normal).abs() < 0.99 {
+                    turned += 1;
+                }
+            }
+            (false, None) => {}
+            _ => flags_differ += 1,
+        }
+    }
+    let pixels = (width * height) as usize;
+    eprintln!(
+        "G-buffer: {both} samples both ways, {flags_differ} pixels with a sample one way only, \
+         {far} positions and {turned} normals apart"
+    );
+    assert!(both > pixels / 2, "{both} samples");
+    assert!(flags_differ as f64 <= 5e-3 * pixels as f64);
+    assert!(far as f64 <= 2e-2 * both as f64);
+    assert!(turned as f64 <= 2e-2 * both as f64);
 }

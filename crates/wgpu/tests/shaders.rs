@@ -85,8 +85,9 @@ fn composed_sources() -> Vec<(&'static str, Result<String, shadowmap_wgpu::Backe
     shadowmap_wgpu::render::composed_shaders()
 }
 
-/// Lookups times filters the renderer composes, RTW's depth pass and refinement.
-const COMPOSITIONS: usize = 4 * 5 + 2;
+/// Lookups times filters the renderer composes, the RTW and paraboloid depth passes
+/// and the refinement.
+const COMPOSITIONS: usize = 4 * 5 + 3;
 
 #[test]
 fn every_shader_file_parses_and_validates() {
@@ -132,7 +133,7 @@ fn composed_sources_parse_and_validate() {
     assert_eq!(
         composed.len(),
         COMPOSITIONS,
-        "every lookup with every filter, RTW's depth pass and refinement"
+        "every lookup with every filter, the RTW and paraboloid depth passes, the refinement"
     );
     let errors: Vec<String> = composed
         .iter()

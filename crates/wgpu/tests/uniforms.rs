@@ -12,8 +12,8 @@ use shadowmap::warp::LispsmOptions;
 use shadowmap::{CascadePlan, DpsmOptions, FitInput, Fitted, Technique, fit};
 use shadowmap_wgpu::shaders;
 use shadowmap_wgpu::uniforms::{
-    CascadeShadowRaw, FrameRaw, MatrixShadowRaw, ParaboloidLayerRaw, RtwShadowRaw, ToRaw,
-    cascade_layers, paraboloid_layers, warped_cascade_layers,
+    CascadeShadowRaw, FrameRaw, MatrixShadowRaw, ParaboloidLayerRaw, ParaboloidLookupRaw,
+    RtwShadowRaw, ToRaw, cascade_layers, paraboloid_layers, warped_cascade_layers,
 };
 
 /// (struct span, member offsets) of `name` in `source`, by naga's layouter.
@@ -79,6 +79,10 @@ fn cascade_block_matches() {
             ("view_z_row", offset_of!(CascadeShadowRaw, view_z_row)),
             ("split_far", offset_of!(CascadeShadowRaw, split_far)),
             ("band_width", offset_of!(CascadeShadowRaw, band_width)),
+            (
+                "layer_uv_scale",
+                offset_of!(CascadeShadowRaw, layer_uv_scale),
+            ),
             ("count", offset_of!(CascadeShadowRaw, count)),
             ("reversed_z", offset_of!(CascadeShadowRaw, reversed_z)),
             (
@@ -103,7 +107,11 @@ fn paraboloid_blocks_match() {
             offset_of!(ParaboloidUniform, far_zoom_reversed_dual),
         ),
     ];
-    for source in [shaders::DEPTH_PARABOLOID, shaders::LOOKUP_PARABOLOID] {
+    for source in [
+        shaders::DEPTH_PARABOLOID,
+        shaders::LOOKUP_PARABOLOID,
+        shaders::REFINE,
+    ] {
         check(
             source,
             "Paraboloid",
@@ -118,6 +126,16 @@ fn paraboloid_blocks_match() {
         &[
             ("map", offset_of!(ParaboloidLayerRaw, map)),
             ("side", offset_of!(ParaboloidLayerRaw, side)),
+            ("warp", offset_of!(ParaboloidLayerRaw, warp)),
+        ],
+    );
+    check(
+        shaders::LOOKUP_PARABOLOID,
+        "ParaboloidLookup",
+        size_of::<ParaboloidLookupRaw>(),
+        &[
+            ("map", offset_of!(ParaboloidLookupRaw, map)),
+            ("warp", offset_of!(ParaboloidLookupRaw, warp)),
         ],
     );
 }

@@ -398,8 +398,10 @@ fn sweep_section(s: &mut String, sweep: &SweepSummary) {
         s,
         "<section id=\"sweep\">\n<h2>Robustness sweep</h2>\n<p>{} random camera and \
          light configurations over the scenes. Each technique's p95 m against its \
-         light's baseline (uniform fit for directional lights, the spot fit for spot \
-         lights, DPSM for point lights): a win is more than {TIE_BAND}× lower, a loss \
+         family's baseline (uniform fit for the directional techniques, the spot fit \
+         for the spot techniques, DPSM for the paraboloid maps, the focused cube maps \
+         for RTW over them, the engines' unfocused cube maps for the focused ones): \
+         a win is more than {TIE_BAND}× lower, a loss \
          more than {TIE_BAND}× higher, a tie in between.</p>\n<figure><img class=\"plot\" \
          src=\"sweep.svg\" alt=\"wins, ties and losses per technique\"><figcaption>Cases \
          per technique by outcome against the baseline.</figcaption></figure>",
@@ -425,10 +427,12 @@ fn sweep_section(s: &mut String, sweep: &SweepSummary) {
             Some(w) => {
                 let _ = writeln!(
                     s,
-                    "<td data-v=\"{:e}\">{:.2}</td><td data-v=\"{1}\" title=\"{2}\">{1}</td></tr>",
+                    "<td data-v=\"{0:e}\">{0:.2} (vs {3})</td><td data-v=\"{1}\" \
+                     title=\"{2}\">{1}</td></tr>",
                     w.ratio(),
                     esc(&w.config),
-                    esc(&w.description)
+                    esc(&w.description),
+                    w.baseline.name()
                 );
             }
             None => s.push_str("<td data-v=\"\">–</td><td data-v=\"\">–</td></tr>\n"),

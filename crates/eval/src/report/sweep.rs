@@ -5,9 +5,13 @@
 //! case, a technique *wins* when its p95 is below the baseline's divided by
 //! [`TIE_BAND`], *loses* when it is above the baseline's times [`TIE_BAND`], and ties
 //! otherwise; a technique or baseline without a p95 (n/a, nothing measured) counts
-//! as unmeasured. The baseline is the light's own ([`baseline_of`]: the uniform or spot
-//! fit, the focused cube maps for a point light);
-//! the RTW oracle is a bound, not a technique, and is not counted.
+//! as unmeasured. Each technique meets the baseline of its family
+//! ([`TechniqueKind::baseline`]): the uniform fit for the directional techniques,
+//! the spot fit for the spot warps and RTW over it, DPSM for the paraboloid maps
+//! (IPSM, RTW over its paraboloid), the focused cube maps for RTW over their faces,
+//! and the engines' cube maps (unfocused, equal faces) for the focused ones. The
+//! baselines themselves (uniform, spot, DPSM, the engines' cube maps) and the RTW
+//! oracle (a bound, not a technique) are not counted.
 
 use std::fmt::Write as _;
 
@@ -28,6 +32,8 @@ pub struct WorstCase {
     pub description: String,
     /// The technique's p95 `m`.
     pub p95: f64,
+    /// The baseline it was measured against ([`TechniqueKind::baseline`]).
+    pub baseline: TechniqueKind,
     /// The baseline's p95 `m`.
     pub baseline_p95: f64,
 }
@@ -66,10 +72,10 @@ pub struct SweepSummary {
     pub tallies: Vec<SweepTally>,
 }
 
-/// The baseline among `techniques` (those of one light): the uniform fit for a
-/// directional light, the spot's own fit for a spot light (or the uniform fit where
-/// it applies), the focused cube maps for a point light (DPSM where they are not
-/// among the techniques).
+/// The baseline among `techniques` (those of one light) that the best of them is
+/// shown against: the uniform fit for a directional light, the spot's own fit for a
+/// spot light (or the uniform fit where it applies), the focused cube maps for a
+/// point light (DPSM where they are not among the techniques).
 #[must_use]
 pub fn baseline_of(techniques: &[TechniqueKind]) -> Option<TechniqueKind> {
     [
@@ -96,18 +102,14 @@ pub(super) fn summarize(cases: &[ConfigSummary], rows: &[Row]) -> SweepSummary {
     let mut tallies: Vec<SweepTally> = Vec::new();
     for case in cases {
         let case_rows: Vec<&Row> = rows.iter().filter(|r| r.config == case.name).collect();
-        let kinds: Vec<TechniqueKind> = case_rows.iter().map(|r| r.technique).collect();
-        let Some(baseline) = baseline_of(&kinds) else {
-            continue;
-        };
-        let base = case_rows
-            .iter()
-            .find(|r| r.technique == baseline)
-            .and_then(|r| p95(r));
         for row in &case_rows {
-            if row.technique == baseline || row.technique == TechniqueKind::RtwOracle {
+            let Some(baseline) = row.technique.baseline() else {
                 continue;
-            }
+            };
+            let base = case_rows
+                .iter()
+                .find(|r| r.technique == baseline)
+                .and_then(|r| p95(r));
             let tally = match tallies
                 .iter_mut()
                 .position(|t| t.technique == row.technique)
@@ -142,6 +144,7 @@ pub(super) fn summarize(cases: &[ConfigSummary], rows: &[Row]) -> SweepSummary {
                     config: case.name.clone(),
                     description: case.description.clone(),
                     p95: p,
+                    baseline,
                     baseline_p95: b,
                 });
             }
@@ -182,7 +185,13 @@ pub(super) fn sweep_table(summary: &SweepSummary, markdown: bool) -> String {
             || ("-".to_string(), "-".to_string()),
             |w| {
                 (
-                    format!("{:.2} ({:.2} / {:.2})", w.ratio(), w.p95, w.baseline_p95),
+                    format!(
+                        "{:.2} ({:.2} / {} {:.2})",
+                        w.ratio(),
+                        w.p95,
+                        w.baseline.name(),
+                        w.baseline_p95
+                    ),
                     w.config.clone(),
                 )
             },

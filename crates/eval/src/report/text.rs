@@ -155,7 +155,7 @@ pub fn summary_table(report: &Report) -> String {
     if let Some(sweep) = &report.sweep {
         let _ = writeln!(
             s,
-            "\nsweep: {} random cases, p95 m against the baseline (win below 1/{TIE_BAND}, \
+            "\nsweep: {} random cases, p95 m against its family's baseline (win below 1/{TIE_BAND}, \
              loss above {TIE_BAND} times)",
             sweep.cases
         );
@@ -224,8 +224,10 @@ fn sweep_section(s: &mut String, sweep: &SweepSummary) {
         "{} random camera and light configurations over the four scenes (directional, \
          spot and point lights in turn; `random_*` rows of `metrics.csv`), each at the \
          sweep's sizes (image {}×{}, {} texels, one frame). Every technique's p95 `m` \
-         against its light's baseline (uniform fit for directional and spot lights, \
-         DPSM for point lights): a win is more than {TIE_BAND}× lower, a loss more than \
+         against its family's baseline (uniform fit for the directional techniques, the \
+         spot fit for the spot techniques, DPSM for the paraboloid maps, the focused \
+         cube maps for RTW over them, the engines' unfocused cube maps for the focused \
+         ones): a win is more than {TIE_BAND}× lower, a loss more than \
          {TIE_BAND}× higher, a tie in between; n/a where either has no measure.\n",
         sweep.cases,
         Settings::sweep().width,

@@ -160,11 +160,57 @@ fn forward_analysis_lifts_texels_the_eye_sees() {
     ));
 }
 
+/// A plane 10 units from the camera, 100 pixels per radian, lit along its normal: a
+/// pixel spans 0.1 units of the identity base, so each axis needs 10 pixels per unit;
+/// seen 30 degrees off the normal (turned about `v`), a pixel spans `0.1 / cos 30°`
+/// along `u`, which needs `10 cos 30°`; a surface the light grazes is measured on
+/// the bisector of the eye and light directions (here the facing plane's).
 #[test]
-fn singular_min_is_right() {
-    let s = singular_min(3.0, 0.0, 0.0, 2.0).unwrap();
-    assert!((s - 2.0).abs() < 1e-12);
-    assert!(singular_min(1.0, 1.0, 1.0, 1.0).is_none());
+fn oracle_needs_are_the_inverse_jacobian() {
+    let base = identity_base();
+    let centre = Vec3::new(0.5, 0.5, 0.0);
+    let needs_from = |direction: Vec3, normal: Vec3| {
+        let camera = shadowmap_frustum::Camera::look_to(
+            centre - direction * 10.0,
+            direction,
+            Vec3::Y,
+            shadowmap_frustum::Projection::perspective(1.0, 1.0, 0.1, 100.0),
+        )
+        .unwrap();
+        let sample = EyeSample {
+            position: centre,
+            normal,
+            eye_distance: 10.0,
+        };
+        let mut needs = Vec::new();
+        let skipped = oracle_needs(&base, &camera, 100.0, &[sample], |_, n| needs.push(n)).unwrap();
+        (skipped, needs.first().copied())
+    };
+    let (_, facing) = needs_from(Vec3::NEG_Z, Vec3::Z);
+    let facing = facing.unwrap();
+    assert!((facing.uv - DVec2::splat(0.5)).length() < 1e-9);
+    for q in [facing.u, facing.v, facing.isotropic] {
+        assert!((q - 10.0).abs() < 1e-6, "{facing:?}");
+    }
+    let a = 30f32.to_radians();
+    let (_, slanted) = needs_from(Vec3::new(-a.sin(), 0.0, -a.cos()), Vec3::Z);
+    let slanted = slanted.unwrap();
+    let expected_u = 10.0 * f64::from(a.cos());
+    assert!((slanted.u - expected_u).abs() < 1e-4, "{slanted:?}");
+    assert!((slanted.v - 10.0).abs() < 1e-4 && (slanted.isotropic - 10.0).abs() < 1e-4);
+    let (skipped, grazed) = needs_from(Vec3::NEG_Z, Vec3::X);
+    assert_eq!((skipped, grazed), (0, Some(facing)));
+    let camera = shadowmap_frustum::Camera::look_to(
+        Vec3::new(0.5, 0.5, 10.0),
+        Vec3::NEG_Z,
+        Vec3::Y,
+        shadowmap_frustum::Projection::perspective(1.0, 1.0, 0.1, 100.0),
+    )
+    .unwrap();
+    assert!(matches!(
+        oracle_needs(&base, &camera, 0.0, &[], |_, _| {}),
+        Err(RtwError::InvalidOption)
+    ));
 }
 
 #[test]
@@ -212,4 +258,29 @@ fn backward_importance_over_a_perspective_base_grows_with_the_light_depth() {
     )
     .unwrap();
     assert_eq!(flat.get(2, 2), Some(1.0 / 5.0));
+}
+
+#[test]
+fn pixel_steps_span_depth_over_focal_length_and_follow_the_surface() {
+    let camera = Camera::look_to(
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::NEG_Z,
+        Vec3::Y,
+        shadowmap_frustum::Projection::perspective(1.0, 1.0, 0.1, 100.0),
+    )
+    .unwrap();
+    let steps = PixelSteps::new(&camera);
+    // A wall facing the eye 10 m away: one pixel at 500 px/rad is 2 cm either way.
+    let p = DVec3::new(0.0, 0.0, -10.0);
+    let (dx, dy) = steps.at(p, DVec3::Z, 500.0).unwrap();
+    assert!((dx - DVec3::new(0.02, 0.0, 0.0)).length() < 1e-12, "{dx}");
+    assert!((dy - DVec3::new(0.0, 0.02, 0.0)).length() < 1e-12, "{dy}");
+    // The floor seen at a slant: the vertical step stretches along the ray.
+    let q = DVec3::new(0.0, -1.0, -10.0);
+    let (_, dy) = steps.at(q, DVec3::Y, 500.0).unwrap();
+    assert!(dy.y.abs() < 1e-12 && dy.length() > 0.1, "{dy}");
+    // Behind the eye, at it, or edge-on: none.
+    assert_eq!(steps.at(DVec3::new(0.0, 0.0, 5.0), DVec3::Z, 500.0), None);
+    assert_eq!(steps.at(DVec3::ZERO, DVec3::Z, 500.0), None);
+    assert_eq!(steps.at(p, DVec3::X, 500.0), None);
 }

@@ -104,20 +104,8 @@ pub(super) struct SceneTargets {
 impl SceneTargets {
     pub(super) fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let target = |format, label| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+            crate::context::texture_2d(device, label, (width, height), format, usage)
         };
         Self {
             color: target(COLOR_FORMAT, "shadowmap color"),

@@ -1,16 +1,21 @@
 //! The headless renderer: a scene from a camera, shadowed by one technique, into an
 //! RGBA8 image (and a PNG) plus a per-pixel shadow mask for tests.
 //!
-//! Each frame renders the technique's depth pass (casters subdivided for the
-//! paraboloid and RTW passes), the moments and blur passes for VSM, then the scene
-//! pass, whose fragment shader is `render_scene.wgsl` with the technique's
-//! `lookup_*.wgsl` and the filter's `filter_*.wgsl` composed in
-//! ([`compose_scene_shader`]). The mask is the plain nearest-texel depth test
-//! (`shadowmap_eval`'s `DepthMap::is_lit`), whatever the filter.
+//! Each frame renders the technique's depth pass (casters refined on the GPU for the
+//! paraboloid and RTW passes, [`crate::refine::GpuRefine`], and drawn indirectly),
+//! the moments and blur passes for VSM, then the scene pass, whose fragment shader
+//! is `render_scene.wgsl` with the technique's `lookup_*.wgsl` and the filter's
+//! `filter_*.wgsl` composed in ([`compose_scene_shader`]). The mask is the plain
+//! nearest-texel depth test (`shadowmap_eval`'s `DepthMap::is_lit`), whatever the
+//! filter.
 //!
-//! The renderer is for tests, reports and examples: it uploads the geometry every
-//! frame and waits for the GPU. An engine would keep the [`ShadowDepthPass`](crate::depth::ShadowDepthPass) and the
-//! lookup shaders and drop the rest.
+//! The renderer is for tests, reports and examples: it waits for the GPU and reads
+//! the image back. It keeps its pipelines, its depth passes (texture and pipeline per
+//! description) and the scene's casters with their refinement across frames (the
+//! casters are compared by value each frame), so a repeated frame records commands
+//! and writes uniforms only. An engine would keep the
+//! [`ShadowDepthPass`](crate::depth::ShadowDepthPass), the refinement and the lookup
+//! shaders and drop the rest.
 //!
 //! ```no_run
 //! use glam::Vec3;
@@ -31,6 +36,7 @@
 //! # Ok::<(), shadowmap_wgpu::BackendError>(())
 //! ```
 
+mod cache;
 mod image;
 mod options;
 mod passes;
@@ -47,20 +53,22 @@ pub use self::options::{RenderOptions, ShadowBias, ShadowFilter};
 pub use self::technique::ShadowTechnique;
 pub use crate::compose::{compose_scene_shader, composed_shaders};
 
+use self::cache::DepthCache;
 use self::image::SceneTargets;
 use self::passes::{DepthJob, SceneInputs, record_scene};
 use self::pipelines::{ScenePipeline, VsmPipelines, create_scene_pipeline};
 use self::technique::Lookup;
-use crate::depth::MeshBuffers;
 use crate::profile::GpuProfiler;
 use crate::uniforms::FrameRaw;
 use crate::{BackendError, GpuContext};
 
-/// Renders scenes headlessly; caches its pipelines across frames.
+/// Renders scenes headlessly; keeps its pipelines, depth passes and the scene's
+/// casters (with their refinement) across frames.
 #[derive(Debug, Default)]
 pub struct HeadlessRenderer {
     scene: HashMap<(Lookup, u8, bool), ScenePipeline>,
     vsm: Option<VsmPipelines>,
+    depth: DepthCache,
 }
 
 impl HeadlessRenderer {
@@ -76,7 +84,7 @@ impl HeadlessRenderer {
     /// # Errors
     /// [`BackendError::InvalidInput`] for an empty or non-finite scene, a zero or too
     /// large image or map, an invalid camera, a cascade set without a (fitted)
-    /// cascade, or caster subdivision failing; [`BackendError::Wgpu`] for any wgpu
+    /// cascade, or caster refinement failing; [`BackendError::Wgpu`] for any wgpu
     /// error; [`BackendError::Readback`].
     pub fn render(
         &mut self,
@@ -125,9 +133,9 @@ impl HeadlessRenderer {
     }
 
     /// [`HeadlessRenderer::render`] with the GPU time of its passes recorded by
-    /// `profiler` in scopes `depth` (every layer, casters uploaded beforehand), `vsm`
-    /// (VSM filter only) and `scene`; read them with [`GpuProfiler::read`] after this
-    /// returns.
+    /// `profiler` in scopes `refine` (the paraboloid and RTW caster refinement),
+    /// `depth` (every layer), `vsm` (VSM filter only) and `scene`; read them with
+    /// [`GpuProfiler::read`] after this returns.
     ///
     /// # Errors
     /// As [`HeadlessRenderer::render`].
@@ -156,27 +164,32 @@ impl HeadlessRenderer {
         let bias = options
             .bias
             .unwrap_or_else(|| ShadowBias::default_for(technique, options.filter));
-        let scene_mesh = MeshBuffers::from_triangles(ctx, triangles)?;
+        self.depth.use_scene(ctx, triangles)?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        // 1. The depth pass, casters subdivided where the projection is not linear.
+        // 1. The depth pass, casters refined where the projection is not linear.
         let job = DepthJob {
-            triangles,
-            scene_mesh: &scene_mesh,
             options,
             bias: bias.raster_for(reversed),
             reversed,
         };
-        let depth = timed(&mut profiler, &mut encoder, "depth", |e| {
-            job.encode(ctx, e, technique)
-        })?;
+        let output = job.encode(
+            (ctx, &mut encoder),
+            &mut self.depth,
+            technique,
+            &mut profiler,
+        )?;
+        let depth = self
+            .depth
+            .pass(output.pass)
+            .ok_or(BackendError::InvalidInput("no depth pass"))?;
         // 2. VSM moments and blur (a 1x1 placeholder for the other filters).
         let vsm = &mut self.vsm;
         let moments = if matches!(options.filter, ShadowFilter::Vsm { .. }) {
             timed(&mut profiler, &mut encoder, "vsm", |e| {
-                passes::encode_vsm(vsm, ctx, e, &depth.pass, options, reversed)
+                passes::encode_vsm(vsm, ctx, e, depth, options, reversed)
             })?
         } else {
-            passes::encode_vsm(vsm, ctx, &mut encoder, &depth.pass, options, reversed)?
+            passes::encode_vsm(vsm, ctx, &mut encoder, depth, options, reversed)?
         };
         // 3. The scene pass.
         let (radius, taps) = options.filter.params();
@@ -191,27 +204,22 @@ impl HeadlessRenderer {
                 radius,
                 f32::from(u8::from(reversed)),
             ],
-            shadow_size: [
-                resolution,
-                resolution,
-                depth.pass.desc().layers as f32,
-                taps,
-            ],
+            shadow_size: [resolution, resolution, depth.desc().layers as f32, taps],
             eye: view.camera.eye().extend(1.0).to_array(),
         };
         let inputs = SceneInputs {
             frame,
             lookup: technique.lookup_bytes(view.view_from_world),
-            tables: depth.tables.as_deref(),
-            depth: &depth.pass,
+            tables: &output.tables,
+            depth,
             moments: &moments,
             reversed,
         };
         let camera_reversed = view.camera.reversed_z;
         let key = (technique.lookup(), options.filter.key(), camera_reversed);
-        let pipeline = self.scene_pipeline(&ctx.device, key, options.filter)?;
+        let pipeline = scene_pipeline(&mut self.scene, &ctx.device, key, options.filter)?;
         let targets = SceneTargets::new(&ctx.device, options.width, options.height);
-        let job = (&scene_mesh, &targets, camera_reversed);
+        let job = (self.depth.mesh()?, &targets, camera_reversed);
         timed(&mut profiler, &mut encoder, "scene", |e| {
             record_scene(ctx, e, pipeline, &inputs, job);
         });
@@ -223,26 +231,24 @@ impl HeadlessRenderer {
     }
 }
 
-impl HeadlessRenderer {
-    /// The cached scene pipeline of (lookup, filter key, camera reversed-Z), created
-    /// on first use.
-    fn scene_pipeline(
-        &mut self,
-        device: &wgpu::Device,
-        key: (Lookup, u8, bool),
-        filter: ShadowFilter,
-    ) -> Result<&ScenePipeline, BackendError> {
-        Ok(match self.scene.entry(key) {
-            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::hash_map::Entry::Vacant(v) => {
-                v.insert(create_scene_pipeline(device, key.0, filter, key.2)?)
-            }
-        })
-    }
+/// The cached scene pipeline of (lookup, filter key, camera reversed-Z), created on
+/// first use.
+fn scene_pipeline<'c>(
+    cache: &'c mut HashMap<(Lookup, u8, bool), ScenePipeline>,
+    device: &wgpu::Device,
+    key: (Lookup, u8, bool),
+    filter: ShadowFilter,
+) -> Result<&'c ScenePipeline, BackendError> {
+    Ok(match cache.entry(key) {
+        std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+        std::collections::hash_map::Entry::Vacant(v) => {
+            v.insert(create_scene_pipeline(device, key.0, filter, key.2)?)
+        }
+    })
 }
 
 /// `record` inside the profiler's scope `label`, or plainly without a profiler.
-fn timed<T>(
+pub(super) fn timed<T>(
     profiler: &mut Option<&mut GpuProfiler>,
     encoder: &mut wgpu::CommandEncoder,
     label: &str,

@@ -80,7 +80,9 @@ pub struct RenderOptions {
     pub bias: Option<ShadowBias>,
     /// The image's filter. Default [`ShadowFilter::Hardware2x2`].
     pub filter: ShadowFilter,
-    /// Paraboloid caster subdivision (its resolution is replaced by
+    /// How casters are subdivided for the paraboloid passes (on the GPU by
+    /// [`crate::refine::GpuRefine`], the twin of
+    /// `shadowmap_paraboloid::subdivide_triangles`; its resolution is replaced by
     /// `shadow_resolution`).
     pub subdivision: SubdivisionOptions,
     /// How casters are subdivided for RTW (on the GPU by [`crate::refine::GpuRefine`],
@@ -206,7 +208,10 @@ impl ShadowBias {
             }
         };
         let k = match technique {
-            ShadowTechnique::Paraboloid(_) | ShadowTechnique::Rtw(_) => 2.0,
+            ShadowTechnique::Paraboloid(_)
+            | ShadowTechnique::ParaboloidRtw { .. }
+            | ShadowTechnique::Rtw(_)
+            | ShadowTechnique::RtwGpu { .. } => 2.0,
             _ => 1.5,
         };
         let world = if matches!(technique, ShadowTechnique::Xpsm(_)) {

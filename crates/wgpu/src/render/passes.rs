@@ -1,32 +1,40 @@
-//! The frame's passes: the technique's depth pass (casters subdivided where its
-//! projection is not linear), VSM moments and blur, and the scene pass.
+//! The frame's passes: the technique's depth pass (casters refined on the GPU where
+//! its projection is not linear), VSM moments and blur, and the scene pass.
 
-use glam::Vec3;
-use shadowmap_paraboloid::{ParaboloidMap, Side, subdivide_triangles};
-use shadowmap_rtw::RtwShadow;
 use wgpu::util::DeviceExt;
 
+use super::cache::DepthCache;
 use super::image::SceneTargets;
 use super::pipelines::{ScenePipeline, VsmPipelines, create_vsm_pipelines, moments_texture};
-use super::{RenderOptions, ShadowFilter, ShadowTechnique};
+use super::{RenderOptions, ShadowFilter, ShadowTechnique, timed};
 use crate::depth::{
     DepthBias, DepthPassDesc, DepthTechnique, DepthUniforms, MeshBuffers, ShadowDepthPass,
     table_buffer,
 };
-use crate::refine::{GpuRefine, RefineOptions};
-use crate::uniforms::{FrameRaw, RtwShadowRaw, ToRaw, paraboloid_layers};
+use crate::profile::GpuProfiler;
+use crate::refine::RefineOptions;
+use crate::uniforms::{FrameRaw, RtwShadowRaw, ToRaw, paraboloid_layers, warped_paraboloid};
 use crate::{BackendError, GpuContext};
 
-/// A recorded depth pass, with the RTW tables the lookup reads too.
-pub(super) struct DepthOutput {
-    pub(super) pass: ShadowDepthPass,
-    pub(super) tables: Option<Vec<f32>>,
+/// The tables the lookup reads (RTW's, a warped paraboloid's).
+pub(super) enum LookupTables<'a> {
+    /// None: the lookup has no table binding.
+    None,
+    /// From the CPU.
+    Owned(Vec<f32>),
+    /// Built on the GPU ([`crate::rtw::GpuRtw::tables_buffer`]).
+    Buffer(&'a wgpu::Buffer),
+}
+
+/// A recorded depth pass (its index in the [`DepthCache`]) and the tables the
+/// lookup reads.
+pub(super) struct DepthOutput<'a> {
+    pub(super) pass: usize,
+    pub(super) tables: LookupTables<'a>,
 }
 
 /// What every depth pass of a frame shares.
 pub(super) struct DepthJob<'a> {
-    pub(super) triangles: &'a [[Vec3; 3]],
-    pub(super) scene_mesh: &'a MeshBuffers,
     pub(super) options: &'a RenderOptions,
     pub(super) bias: DepthBias,
     pub(super) reversed: bool,
@@ -40,83 +48,116 @@ impl DepthJob<'_> {
             .with_bias(self.bias)
     }
 
-    /// Records the technique's depth pass into `encoder`.
-    pub(super) fn encode(
+    /// Records the technique's depth pass into `encoder`: the scene mesh for the
+    /// matrix techniques; for the paraboloid and RTW passes the casters refined on
+    /// the GPU ([`crate::refine::GpuRefine`], the twin of the CPU references
+    /// `subdivide_triangles` and `subdivide_for_rtw`) and drawn indirectly, in scopes
+    /// `refine` and `depth` of `profiler`.
+    pub(super) fn encode<'t>(
         &self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        technique: &ShadowTechnique<'_>,
-    ) -> Result<DepthOutput, BackendError> {
+        (ctx, encoder): (&GpuContext, &mut wgpu::CommandEncoder),
+        cache: &mut DepthCache,
+        technique: &ShadowTechnique<'t>,
+        profiler: &mut Option<&mut GpuProfiler>,
+    ) -> Result<DepthOutput<'t>, BackendError> {
         if let Some(blocks) = technique.matrix_layers() {
-            let mut pass =
-                ShadowDepthPass::new(ctx, &self.desc(DepthTechnique::Matrix, blocks.len()))?;
-            let uniforms = DepthUniforms::Matrix(&blocks);
-            pass.encode(ctx, encoder, &[self.scene_mesh], &uniforms)?;
-            return Ok(DepthOutput { pass, tables: None });
+            let index = cache.pass_index(ctx, &self.desc(DepthTechnique::Matrix, blocks.len()))?;
+            let (pass, mesh, _) = cache.parts(ctx, index, None)?;
+            timed(profiler, encoder, "depth", |e| {
+                pass.encode(ctx, e, &[mesh], &DepthUniforms::Matrix(&blocks))
+            })?;
+            return Ok(DepthOutput {
+                pass: index,
+                tables: LookupTables::None,
+            });
         }
+        let refine = RefineOptions::default()
+            .with_subdivision(self.options.rtw_subdivision)
+            .with_paraboloid(self.options.subdivision)
+            .with_resolution(self.options.shadow_resolution);
+        let job = RefinedJob {
+            ctx,
+            cache,
+            refine: &refine,
+        };
+        let rtw_desc = self.desc(DepthTechnique::Rtw, 1);
         match technique {
-            ShadowTechnique::Paraboloid(map) => self.paraboloid(ctx, encoder, map),
-            ShadowTechnique::Rtw(shadow) => self.rtw(ctx, encoder, shadow),
+            ShadowTechnique::Paraboloid(map) => {
+                let layers = paraboloid_layers(map);
+                let uniforms = DepthUniforms::Paraboloid(&layers);
+                let desc = self.desc(DepthTechnique::Paraboloid, layers.len());
+                let pass = job.record(encoder, &desc, &uniforms, profiler)?;
+                Ok(DepthOutput {
+                    pass,
+                    tables: LookupTables::Owned(vec![0.0]),
+                })
+            }
+            ShadowTechnique::ParaboloidRtw { map, front, back } => {
+                let warped = warped_paraboloid(map, Some(front), *back);
+                let uniforms = DepthUniforms::WarpedParaboloid {
+                    layers: &warped.layers,
+                    tables: &warped.tables,
+                };
+                let desc = self.desc(DepthTechnique::Paraboloid, warped.layers.len());
+                let pass = job.record(encoder, &desc, &uniforms, profiler)?;
+                Ok(DepthOutput {
+                    pass,
+                    tables: LookupTables::Owned(warped.tables),
+                })
+            }
+            ShadowTechnique::Rtw(shadow) => {
+                let tables = RtwShadowRaw::tables(shadow);
+                let uniforms = DepthUniforms::Rtw {
+                    raw: shadow.to_raw(),
+                    tables: &tables,
+                };
+                let pass = job.record(encoder, &rtw_desc, &uniforms, profiler)?;
+                Ok(DepthOutput {
+                    pass,
+                    tables: LookupTables::Owned(tables),
+                })
+            }
+            ShadowTechnique::RtwGpu { base, rtw } => {
+                let uniforms = rtw.depth_uniforms(base);
+                let pass = job.record(encoder, &rtw_desc, &uniforms, profiler)?;
+                Ok(DepthOutput {
+                    pass,
+                    tables: LookupTables::Buffer(rtw.tables_buffer()),
+                })
+            }
             _ => Err(BackendError::InvalidInput("technique without a depth pass")),
         }
     }
+}
 
-    /// One layer per side, each from casters subdivided for that side.
-    fn paraboloid(
-        &self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        map: &ParaboloidMap,
-    ) -> Result<DepthOutput, BackendError> {
-        let sub = self
-            .options
-            .subdivision
-            .with_resolution(self.options.shadow_resolution);
-        let blocks = paraboloid_layers(map);
-        let mut meshes = Vec::new();
-        let mut out = Vec::new();
-        for side in [Side::Front, Side::Back].into_iter().take(blocks.len()) {
-            subdivide_triangles(map, side, self.triangles, &sub, &mut out)
-                .map_err(|_| BackendError::InvalidInput("paraboloid subdivision failed"))?;
-            meshes.push(MeshBuffers::from_triangles(ctx, &out)?);
-        }
-        let refs: Vec<&MeshBuffers> = meshes.iter().collect();
-        let mut pass =
-            ShadowDepthPass::new(ctx, &self.desc(DepthTechnique::Paraboloid, blocks.len()))?;
-        pass.encode(ctx, encoder, &refs, &DepthUniforms::Paraboloid(&blocks))?;
-        Ok(DepthOutput { pass, tables: None })
-    }
+/// A depth pass drawn from casters refined on the GPU.
+struct RefinedJob<'c> {
+    ctx: &'c GpuContext,
+    cache: &'c mut DepthCache,
+    refine: &'c RefineOptions,
+}
 
-    /// One layer from casters refined against the warp tables on the GPU
-    /// ([`GpuRefine`], the twin of the CPU reference `subdivide_for_rtw`), drawn
-    /// indirectly.
-    fn rtw(
-        &self,
-        ctx: &GpuContext,
+impl RefinedJob<'_> {
+    /// Records the refinement (scope `refine`) and the indirect depth pass (scope
+    /// `depth`); returns the pass's index in the cache.
+    fn record(
+        self,
         encoder: &mut wgpu::CommandEncoder,
-        shadow: &RtwShadow<'_>,
-    ) -> Result<DepthOutput, BackendError> {
-        let sub = self
-            .options
-            .rtw_subdivision
-            .with_resolution(self.options.shadow_resolution);
-        let mut refine = GpuRefine::new(
-            ctx,
-            self.triangles,
-            &RefineOptions::default().with_subdivision(sub),
-        )?;
-        let tables = RtwShadowRaw::tables(shadow);
-        let mut pass = ShadowDepthPass::new(ctx, &self.desc(DepthTechnique::Rtw, 1))?;
-        let uniforms = DepthUniforms::Rtw {
-            raw: shadow.to_raw(),
-            tables: &tables,
-        };
-        refine.encode(ctx, encoder, &uniforms)?;
-        pass.encode_refined(ctx, encoder, &refine, &uniforms)?;
-        Ok(DepthOutput {
-            pass,
-            tables: Some(tables),
-        })
+        desc: &DepthPassDesc,
+        uniforms: &DepthUniforms<'_>,
+        profiler: &mut Option<&mut GpuProfiler>,
+    ) -> Result<usize, BackendError> {
+        let ctx = self.ctx;
+        let index = self.cache.pass_index(ctx, desc)?;
+        let (pass, _, refine) = self.cache.parts(ctx, index, Some(self.refine))?;
+        let refine = refine.ok_or(BackendError::InvalidInput("no refinement"))?;
+        timed(profiler, encoder, "refine", |e| {
+            refine.encode(ctx, e, uniforms)
+        })?;
+        timed(profiler, encoder, "depth", |e| {
+            pass.encode_refined(ctx, e, refine, uniforms)
+        })?;
+        Ok(index)
     }
 }
 
@@ -240,7 +281,7 @@ fn record_vsm_step(
 pub(super) struct SceneInputs<'a> {
     pub(super) frame: FrameRaw,
     pub(super) lookup: Vec<u8>,
-    pub(super) tables: Option<&'a [f32]>,
+    pub(super) tables: &'a LookupTables<'a>,
     pub(super) depth: &'a ShadowDepthPass,
     pub(super) moments: &'a wgpu::Texture,
     pub(super) reversed: bool,
@@ -270,16 +311,23 @@ fn scene_bind_groups(
             resource: frame_buffer.as_entire_binding(),
         }],
     });
-    let table_buf = inputs.tables.map(|t| {
-        let b = table_buffer(device, (t.len() * 4) as u64);
-        ctx.queue.write_buffer(&b, 0, bytemuck::cast_slice(t));
-        b
-    });
+    let owned = match inputs.tables {
+        LookupTables::Owned(t) => {
+            let b = table_buffer(device, (t.len() * 4) as u64);
+            ctx.queue.write_buffer(&b, 0, bytemuck::cast_slice(t));
+            Some(b)
+        }
+        LookupTables::None | LookupTables::Buffer(_) => None,
+    };
+    let table_buf = match inputs.tables {
+        LookupTables::Buffer(b) => Some(*b),
+        LookupTables::Owned(_) | LookupTables::None => owned.as_ref(),
+    };
     let mut lookup_entries = vec![wgpu::BindGroupEntry {
         binding: 0,
         resource: lookup_buffer.as_entire_binding(),
     }];
-    if let Some(b) = &table_buf {
+    if let Some(b) = table_buf {
         lookup_entries.push(wgpu::BindGroupEntry {
             binding: 1,
             resource: b.as_entire_binding(),

@@ -7,7 +7,8 @@ use super::ShadowFilter;
 use super::image::{COLOR_FORMAT, MASK_FORMAT};
 use super::technique::Lookup;
 use crate::compose::compose_scene_shader;
-use crate::depth::{DepthBias, MeshBuffers, depth_state};
+use crate::context::mesh_pipeline;
+use crate::depth::{DepthBias, depth_state};
 use crate::uniforms::FrameRaw;
 use crate::{BackendError, shaders};
 
@@ -132,7 +133,8 @@ pub(super) fn create_vsm_pipelines(device: &wgpu::Device) -> VsmPipelines {
     }
 }
 
-/// The scene pass's bind group layouts: frame, lookup (with RTW's tables), maps.
+/// The scene pass's bind group layouts: frame, lookup (with the warp tables of RTW
+/// and the paraboloid), maps.
 fn scene_layouts(device: &wgpu::Device, lookup: Lookup) -> [wgpu::BindGroupLayout; 3] {
     let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("shadowmap frame"),
@@ -144,7 +146,7 @@ fn scene_layouts(device: &wgpu::Device, lookup: Lookup) -> [wgpu::BindGroupLayou
     });
     // The block size depends on the technique: no minimum.
     let mut lookup_entries = vec![uniform_entry(0, wgpu::ShaderStages::FRAGMENT, 0)];
-    if lookup == Lookup::Rtw {
+    if matches!(lookup, Lookup::Rtw | Lookup::Paraboloid) {
         lookup_entries.push(wgpu::BindGroupLayoutEntry {
             binding: 1,
             visibility: wgpu::ShaderStages::FRAGMENT,
@@ -198,30 +200,13 @@ pub(super) fn create_scene_pipeline(
         label: Some("shadowmap scene"),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("shadowmap scene"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(MeshBuffers::layout())],
-        },
-        primitive: wgpu::PrimitiveState {
-            cull_mode: None,
-            ..Default::default()
-        },
-        depth_stencil: Some(depth_state(camera_reversed_z, DepthBias::default())),
-        multisample: Default::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(COLOR_FORMAT.into()), Some(MASK_FORMAT.into())],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
+    let targets = [Some(COLOR_FORMAT.into()), Some(MASK_FORMAT.into())];
+    let pipeline = mesh_pipeline(
+        device,
+        ("shadowmap scene", Some(&pipeline_layout), &module),
+        depth_state(camera_reversed_z, DepthBias::default()),
+        Some(&targets),
+    );
     Ok(ScenePipeline {
         pipeline,
         frame_layout,

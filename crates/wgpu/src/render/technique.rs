@@ -1,15 +1,16 @@
 //! Which technique the renderer draws: its lookup shader, light, depth direction
 //! and uniform blocks, chosen in one match per question.
 
-use bytemuck::Zeroable;
 use glam::Mat4;
 use shadowmap_frustum::{CascadeSet, LightDirection, ShadowTransform};
 use shadowmap_paraboloid::{CubeMap, ParaboloidMap};
-use shadowmap_rtw::RtwShadow;
+use shadowmap_rtw::{RtwShadow, WarpMaps};
 use shadowmap_warp::{WarpedCascades, XpsmShadow};
 
+use crate::rtw::GpuRtw;
 use crate::uniforms::{
-    CascadeShadowRaw, MatrixShadowRaw, ToRaw, cascade_layers, warped_cascade_layers,
+    CascadeShadowRaw, MatrixShadowRaw, ParaboloidLookupRaw, RtwShadowRaw, ToRaw, cascade_layers,
+    cube_layers, warped_cascade_layers, warped_paraboloid,
 };
 use crate::{BackendError, compose, shaders};
 
@@ -27,8 +28,27 @@ pub enum ShadowTechnique<'a> {
     CascadesByProjection(&'a CascadeSet, f32),
     /// A paraboloid map (DPSM or cut IPSM map).
     Paraboloid(&'a ParaboloidMap),
-    /// Rectilinear texture warping.
+    /// Rectilinear texture warping over an orthographic base (the uniform fit) or a
+    /// perspective one (the spot fit), tables from the CPU.
     Rtw(&'a RtwShadow<'a>),
+    /// Rectilinear texture warping with the tables [`GpuRtw`] built on the GPU over
+    /// `base` (record and submit its `encode` before the frame).
+    RtwGpu {
+        /// The base fit the tables were built over.
+        base: &'a ShadowTransform,
+        /// The GPU analysis holding the tables.
+        rtw: &'a GpuRtw,
+    },
+    /// Rectilinear texture warping over each side of a paraboloid map (`point_rtw`):
+    /// the side's projection, then its tables; a side without tables is not warped.
+    ParaboloidRtw {
+        /// The map (IPSM's).
+        map: &'a ParaboloidMap,
+        /// The front side's tables.
+        front: &'a WarpMaps,
+        /// The back side's tables (a dual map).
+        back: Option<&'a WarpMaps>,
+    },
     /// Parallel-split cascades with a LiSPSM warp each
     /// (`shadowmap_warp::warped_cascades`): one layer per cascade rendered with its
     /// perspective matrix, the cascade selected by view depth with the blend band
@@ -36,9 +56,12 @@ pub enum ShadowTechnique<'a> {
     /// (its slice has no receivers) renders nothing and reads as not covered.
     WarpedCascades(&'a WarpedCascades),
     /// Cube shadow maps (`shadowmap_paraboloid::CubeMap`): one layer per kept face,
-    /// rendered with the face's perspective matrix; the lookup is the cascades'
-    /// selection by projection (the first face whose window holds the point, the
-    /// windows being disjoint up to rounding) with the `uv` divided by `w`.
+    /// rendered with the face's perspective matrix into the top-left corner of a
+    /// layer of the largest face's side (faces sized by need keep their texel
+    /// densities; render at `CubeMap::largest_side`, as `render_shadow` does); the
+    /// lookup is the cascades' selection by projection (the first face whose window
+    /// holds the point, the windows being disjoint up to rounding) with the `uv`
+    /// divided by `w` and scaled to the face's corner.
     Cube(&'a CubeMap),
 }
 
@@ -57,7 +80,7 @@ impl Lookup {
         match self {
             Self::Matrix => Ok(shaders::LOOKUP_MATRIX.to_owned()),
             Self::Cascades => Ok(shaders::LOOKUP_CASCADES.to_owned()),
-            Self::Paraboloid => Ok(shaders::LOOKUP_PARABOLOID.to_owned()),
+            Self::Paraboloid => compose::lookup_paraboloid(),
             Self::Rtw => compose::lookup_rtw(),
         }
     }
@@ -71,8 +94,8 @@ impl ShadowTechnique<'_> {
             | Self::CascadesByProjection(..)
             | Self::WarpedCascades(_)
             | Self::Cube(_) => Lookup::Cascades,
-            Self::Paraboloid(_) => Lookup::Paraboloid,
-            Self::Rtw(_) => Lookup::Rtw,
+            Self::Paraboloid(_) | Self::ParaboloidRtw { .. } => Lookup::Paraboloid,
+            Self::Rtw(_) | Self::RtwGpu { .. } => Lookup::Rtw,
         }
     }
 
@@ -92,7 +115,8 @@ impl ShadowTechnique<'_> {
                 .find_map(|c| c.shadow.as_ref())
                 .map(|s| &s.transform),
             Self::Rtw(r) => Some(&r.base),
-            Self::Paraboloid(_) | Self::Cube(_) => None,
+            Self::RtwGpu { base, .. } => Some(base),
+            Self::Paraboloid(_) | Self::ParaboloidRtw { .. } | Self::Cube(_) => None,
         }
     }
 
@@ -103,7 +127,9 @@ impl ShadowTechnique<'_> {
     /// there is no light to read, and none is made up.
     pub(super) fn light(&self) -> Result<LightDirection, BackendError> {
         match self {
-            Self::Paraboloid(m) => Ok(LightDirection::Position(m.position)),
+            Self::Paraboloid(m) | Self::ParaboloidRtw { map: m, .. } => {
+                Ok(LightDirection::Position(m.position))
+            }
             Self::Cube(c) => Ok(LightDirection::Position(c.position)),
             _ => self
                 .first_transform()
@@ -114,7 +140,7 @@ impl ShadowTechnique<'_> {
 
     pub(super) fn reversed_z(&self) -> bool {
         match self {
-            Self::Paraboloid(m) => m.reversed_z,
+            Self::Paraboloid(m) | Self::ParaboloidRtw { map: m, .. } => m.reversed_z,
             Self::Cube(c) => c.reversed_z,
             _ => self.first_transform().is_some_and(|t| t.reversed_z),
         }
@@ -128,13 +154,11 @@ impl ShadowTechnique<'_> {
             Self::Xpsm(x) => Some(vec![x.to_raw()]),
             Self::Cascades(s) | Self::CascadesByProjection(s, _) => Some(cascade_layers(s)),
             Self::WarpedCascades(w) => Some(warped_cascade_layers(w)),
-            Self::Cube(c) => Some(
-                (0..c.layers())
-                    .filter_map(|layer| c.transform(layer))
-                    .map(|t| t.to_raw())
-                    .collect(),
-            ),
-            Self::Paraboloid(_) | Self::Rtw(_) => None,
+            Self::Cube(c) => Some(cube_layers(c)),
+            Self::Paraboloid(_)
+            | Self::ParaboloidRtw { .. }
+            | Self::Rtw(_)
+            | Self::RtwGpu { .. } => None,
         }
     }
 
@@ -153,26 +177,16 @@ impl ShadowTechnique<'_> {
             Self::WarpedCascades(w) => {
                 bytemuck::bytes_of(&CascadeShadowRaw::from_warped(w, view_from_world)).to_vec()
             }
-            Self::Paraboloid(m) => bytemuck::bytes_of(&m.to_raw()).to_vec(),
-            Self::Cube(c) => bytemuck::bytes_of(&cube_lookup(c)).to_vec(),
+            Self::Paraboloid(m) => bytemuck::bytes_of(&ParaboloidLookupRaw::new(m)).to_vec(),
+            Self::ParaboloidRtw { map, front, back } => {
+                bytemuck::bytes_of(&warped_paraboloid(map, Some(front), *back).lookup).to_vec()
+            }
+            Self::Cube(c) => bytemuck::bytes_of(&CascadeShadowRaw::from_cube(c)).to_vec(),
             Self::Rtw(r) => bytemuck::bytes_of(&r.to_raw()).to_vec(),
+            Self::RtwGpu { base, rtw } => {
+                bytemuck::bytes_of(&RtwShadowRaw::from_base(base, rtw.width(), rtw.height()))
+                    .to_vec()
+            }
         }
     }
-}
-
-/// The cascades lookup block of a cube map: one perspective `uv_from_world` per kept
-/// face, selected by projection without a margin (adjacent windows meet at the face
-/// edges).
-fn cube_lookup(cube: &CubeMap) -> CascadeShadowRaw {
-    let mut raw = CascadeShadowRaw::zeroed();
-    let n = raw.uv_from_world.len();
-    for (slot, layer) in raw.uv_from_world.iter_mut().zip(0..cube.layers()) {
-        if let Some(t) = cube.transform(layer) {
-            *slot = t.uv_from_world.to_cols_array_2d();
-        }
-    }
-    raw.count = cube.layers().min(n as u32);
-    raw.reversed_z = u32::from(cube.reversed_z);
-    raw.select_by_projection = 1;
-    raw
 }

@@ -20,20 +20,7 @@ pub(super) struct Targets {
 impl Targets {
     fn new(device: &wgpu::Device, (width, height): (u32, u32)) -> Self {
         let target = |format, usage, label| {
-            device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
+            crate::context::texture_2d(device, label, (width, height), format, usage)
         };
         let attach = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let class = target(

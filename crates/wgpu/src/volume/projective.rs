@@ -147,20 +147,13 @@ fn texture(
     format: wgpu::TextureFormat,
     usage: wgpu::TextureUsages,
 ) -> wgpu::Texture {
-    ctx.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("shadowmap projective target"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
+    crate::context::texture_2d(
+        &ctx.device,
+        "shadowmap projective target",
+        (w, h),
         format,
         usage,
-        view_formats: &[],
-    })
+    )
 }
 
 impl ProjectiveRenderer {

@@ -1,0 +1,85 @@
+//! Per-frame cost of the umbrella's stateful fits of a directional light
+//! (`shadowmap::fit_with_state`): the stable, tight and warped cascades with their
+//! count chosen from the predicted error, and `auto`, which fits and predicts all
+//! seven candidates; each beside the uniform fit timed in the same run. Besides
+//! criterion's figures it prints each fit's time per call (the fastest of many short
+//! batches, see `support/timing.rs`) and its ratio to the uniform fit.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::Vec3;
+use shadowmap::frustum::{Aabb, Camera, DepthBounds, Light, Projection, SceneBounds};
+use shadowmap::{CascadePlan, FitInput, FitState, Technique, fit_with_state};
+use std::hint::black_box;
+
+#[path = "support/timing.rs"]
+mod timing;
+
+/// A street view: a camera 2 m over a 400 m ground with 40 m of casters, the sun
+/// from the side and above, the depth bounds of what it sees.
+fn frame() -> (Camera, Light, SceneBounds, DepthBounds) {
+    let camera = Camera::look_to(
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::new(0.1, -0.15, -1.0),
+        Vec3::Y,
+        Projection::perspective(1.0, 16.0 / 9.0, 0.5, 300.0),
+    )
+    .unwrap();
+    let ground = Aabb::new(Vec3::new(-200.0, -1.0, -300.0), Vec3::new(200.0, 0.0, 10.0));
+    let casters = ground.union(&Aabb::new(
+        Vec3::new(-200.0, 0.0, -300.0),
+        Vec3::new(200.0, 40.0, 10.0),
+    ));
+    let light = Light::Directional {
+        direction: Vec3::new(0.4, -1.0, 0.3),
+    };
+    let bounds = DepthBounds {
+        min: 2.0,
+        max: 280.0,
+    };
+    (camera, light, SceneBounds::new(ground, casters), bounds)
+}
+
+#[allow(clippy::print_stdout)] // The table is this bench's output.
+fn fits(c: &mut Criterion) {
+    let (camera, light, scene, bounds) = frame();
+    let input = FitInput::new(&camera, &light, scene, 2048 * 2048).with_depth_bounds(Some(bounds));
+    let plan = CascadePlan::default();
+    let techniques = [
+        ("uniform", Technique::UniformFocused(Default::default())),
+        ("tight_cascades", Technique::TightCascades(plan)),
+        ("stable_cascades", Technique::StableCascades(plan)),
+        (
+            "warped_cascades",
+            Technique::WarpedCascades {
+                plan,
+                lispsm: Default::default(),
+            },
+        ),
+        ("auto", Technique::Auto(plan)),
+    ];
+    let mut group = c.benchmark_group("fit_with_state");
+    for (name, technique) in &techniques {
+        let mut state = FitState::default();
+        group.bench_function(*name, |b| {
+            b.iter(|| fit_with_state(black_box(technique), black_box(&input), &mut state));
+        });
+    }
+    group.finish();
+    let time = |technique: &Technique| {
+        let mut state = FitState::default();
+        timing::min_ns(|| fit_with_state(technique, &input, &mut state))
+    };
+    let uniform = time(&techniques[0].1);
+    println!("\nper-frame fit_with_state, fastest batch (same run):");
+    for (name, technique) in &techniques {
+        let ns = time(technique);
+        println!(
+            "  {name:<16} {:>9.1} us  {:>6.1}x uniform",
+            ns / 1e3,
+            ns / uniform
+        );
+    }
+}
+
+criterion_group!(benches, fits);
+criterion_main!(benches);

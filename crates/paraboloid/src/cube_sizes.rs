@@ -1,0 +1,442 @@
+//! How a cube map's kept faces share the texel budget, and where each face lies in
+//! the atlas that stores them.
+//!
+//! Equal sides give every kept face `floor(sqrt(budget / k))` texels per side, one
+//! texture-array layer each (the atlas is then a column of equal tiles). Sides by need
+//! give each face a side in proportion to the texel density it needs, so that the
+//! predicted aliasing error is the same on every face:
+//!
+//! ```text
+//! m_f = need_f / side_f          need_f: the 95th percentile of m over the face's
+//!                                  rays for a face of one texel per side
+//! side_f = k * max(need_f, MIN_SIDE_RATIO * max_g need_g)
+//! ```
+//!
+//! with `k` the largest scale whose atlas fits the budget. The needs come from
+//! `shadowmap_frustum::predict_errors`: view rays stopped on the receivers' box, each
+//! face measured as a mapping of its own (its window only). The faces are packed into
+//! shelves (largest first, the atlas as wide as the largest face), and the budget pays
+//! for the whole atlas, gaps included.
+
+use arrayvec::ArrayVec;
+use glam::{DMat4, DVec2, DVec3, DVec4, Mat4, Vec2};
+use shadowmap_frustum::{
+    Aabb, Camera, PredictOptions, PredictedError, ShadowMapping, ShadowSample, math, predict_errors,
+};
+
+use crate::cube::{CubeFace, CubeMap, CubeOptions};
+
+/// How [`CubeMap::fit`](crate::CubeMap::fit) shares the texel budget between the
+/// kept faces.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum FaceSizes {
+    /// Every kept face the same side, `floor(sqrt(budget / faces))`: one
+    /// texture-array layer per face, what engines render.
+    #[default]
+    Equal,
+    /// Sides in proportion to the texel density each face needs, predicted from
+    /// the camera and the receivers' box (see the crate docs, "Cube maps"), packed
+    /// into an atlas. Where the light is among the visible receivers every face is
+    /// kept, and the faces toward the eye need several times the texels of the
+    /// others.
+    ByNeed,
+}
+
+/// No face's side below this fraction of the largest face's: caps what a face loses
+/// when its need is misjudged (by the receivers' box, say).
+pub const MIN_SIDE_RATIO: f64 = 0.25;
+
+/// No face's map narrower along one axis than this fraction of the other.
+pub const MIN_ASPECT: f64 = 0.125;
+
+/// Smallest side of a face, in texels (as the umbrella's layers).
+const MIN_SIDE: u32 = 4;
+
+/// Largest atlas side, in texels.
+const MAX_SIDE: u32 = shadowmap_frustum::MAX_RESOLUTION;
+
+/// Rays of the need prediction (columns, rows).
+const NEED_GRID: (u32, u32) = (24, 14);
+
+/// One kept face as a mapping of its own: its window only, any layer number.
+struct FaceWindow<'a> {
+    face: &'a CubeFace,
+    position: DVec3,
+}
+
+impl ShadowMapping for FaceWindow<'_> {
+    fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
+        self.face.sample(world - self.position, false, 0)
+    }
+}
+
+/// The texel density each face needs: the 95th percentile of the predicted `m` on
+/// its rays for a face of one texel per side; `None` where no ray meets the face's
+/// window (or the prediction fails).
+pub(crate) fn predicted_needs(
+    faces: &[CubeFace],
+    position: DVec3,
+    camera: &Camera,
+    receivers: &Aabb,
+) -> ArrayVec<Option<f64>, 6> {
+    let windows: ArrayVec<FaceWindow<'_>, 6> = faces
+        .iter()
+        .take(6)
+        .map(|face| FaceWindow { face, position })
+        .collect();
+    let candidates: ArrayVec<(&dyn ShadowMapping, u32), 6> = windows
+        .iter()
+        .map(|w| (w as &dyn ShadowMapping, 1))
+        .collect();
+    let mut out = [None::<PredictedError>; 6];
+    let options = PredictOptions::new().with_grid(NEED_GRID.0, NEED_GRID.1);
+    let n = candidates.len();
+    let ok = predict_errors(camera, receivers, &candidates, &options, &mut out[..n]).is_ok();
+    out[..n]
+        .iter()
+        .map(|p| {
+            p.filter(|_| ok)
+                .map(|p| p.percentile)
+                .filter(|m| m.is_finite() && *m > 0.0)
+        })
+        .collect()
+}
+
+/// A face map's width and height in texels.
+pub(crate) type Size = [u32; 2];
+
+/// Square maps of `count` faces sharing `budget` texels equally.
+pub(crate) fn equal_sizes(count: usize, budget: u64) -> ArrayVec<Size, 6> {
+    let per = budget / count.max(1) as u64;
+    let side = (math::sqrt(per as f64) as u32).clamp(MIN_SIDE, MAX_SIDE);
+    (0..count.min(6)).map(|_| [side, side]).collect()
+}
+
+/// Sizes in proportion to `needs` (per face the density needed along `u` and `v`;
+/// a face without a need gets the smallest one allowed), at the largest scale whose
+/// atlas fits `budget` (at least [`MIN_SIDE`] per axis).
+///
+/// A face's larger need is at least [`MIN_SIDE_RATIO`] times the largest of all
+/// faces, and its smaller one at least [`MIN_ASPECT`] times its larger one.
+pub(crate) fn sizes_by_need(needs: &[Option<[f64; 2]>], budget: u64) -> ArrayVec<Size, 6> {
+    let valid = |n: &[f64; 2]| n.iter().all(|x| x.is_finite() && *x > 0.0);
+    let top = needs
+        .iter()
+        .flatten()
+        .filter(|n| valid(n))
+        .map(|n| n[0].max(n[1]))
+        .fold(0.0, f64::max);
+    if !(top > 0.0 && top.is_finite()) {
+        return equal_sizes(needs.len(), budget);
+    }
+    let floor = top * MIN_SIDE_RATIO;
+    let weights: ArrayVec<[f64; 2], 6> = needs
+        .iter()
+        .take(6)
+        .map(|n| {
+            let n = n.filter(valid).unwrap_or([floor, floor]);
+            let m = n[0].max(n[1]);
+            let larger = m.max(floor);
+            n.map(|x| (x * larger / m).max(larger * MIN_ASPECT) / top)
+        })
+        .collect();
+    let sizes_at = |k: f64| -> ArrayVec<Size, 6> {
+        weights
+            .iter()
+            .map(|w| w.map(|x| ((k * x) as u32).clamp(MIN_SIDE, MAX_SIDE)))
+            .collect()
+    };
+    let fits = |k: f64| pack(&sizes_at(k)).1.is_some_and(|a| area(a) <= budget);
+    // The scale without gaps is an upper bound; bisect below it.
+    let total: f64 = weights.iter().map(|w| w[0] * w[1]).sum();
+    let (mut lo, mut hi) = (0.0, math::sqrt(budget as f64 / total) + 1.0);
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if fits(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    sizes_at(lo)
+}
+
+/// Texels of an atlas.
+pub(crate) fn area(atlas: [u32; 2]) -> u64 {
+    u64::from(atlas[0]) * u64::from(atlas[1])
+}
+
+/// Shelf packing of the face maps: the highest first (ties: the wider, then face
+/// order), each shelf as high as its first map. Of two atlas widths, the widest map
+/// and the side of a square of the maps' total area (if wider), the one giving the
+/// smaller atlas. The maps' offsets in face order and the atlas size; `None` when
+/// the atlas would exceed the largest texture side.
+pub(crate) fn pack(sizes: &[Size]) -> (ArrayVec<[u32; 2], 6>, Option<[u32; 2]>) {
+    let sizes = sizes.get(..6).unwrap_or(sizes);
+    let widest = sizes.iter().map(|s| s[0]).max().unwrap_or(0);
+    let total: u64 = sizes.iter().map(|s| area(*s)).sum();
+    let square = (math::ceil(math::sqrt(total as f64)) as u32).max(widest);
+    let narrow = pack_width(sizes, widest);
+    let wide = pack_width(sizes, square);
+    let size = |p: &(ArrayVec<[u32; 2], 6>, Option<[u32; 2]>)| p.1.map_or(u64::MAX, area);
+    if size(&wide) < size(&narrow) {
+        wide
+    } else {
+        narrow
+    }
+}
+
+/// [`pack`] into shelves of width `width` (at least the widest map).
+fn pack_width(sizes: &[Size], width: u32) -> (ArrayVec<[u32; 2], 6>, Option<[u32; 2]>) {
+    let mut order: ArrayVec<usize, 6> = (0..sizes.len()).collect();
+    order.sort_by(|a, b| {
+        let (sa, sb) = (sizes[*a], sizes[*b]);
+        sb[1].cmp(&sa[1]).then(sb[0].cmp(&sa[0])).then(a.cmp(b))
+    });
+    let mut offsets: ArrayVec<[u32; 2], 6> = (0..order.len()).map(|_| [0, 0]).collect();
+    let (mut x, mut y, mut shelf) = (0u64, 0u64, 0u64);
+    for &i in &order {
+        let [w, h] = sizes[i].map(u64::from);
+        if x + w > u64::from(width) {
+            y += shelf;
+            (x, shelf) = (0, 0);
+        }
+        offsets[i] = [x as u32, y.min(u64::from(u32::MAX)) as u32];
+        x += w;
+        shelf = shelf.max(h);
+    }
+    let height = y + shelf;
+    let atlas = (height <= u64::from(MAX_SIDE)).then_some([width, height as u32]);
+    (offsets, atlas)
+}
+
+impl CubeMap {
+    /// Gives each kept face its size ([`CubeOptions::sizes`]) and its place in the
+    /// atlas.
+    pub(crate) fn share_budget(
+        &mut self,
+        camera: &Camera,
+        receivers: &Aabb,
+        options: &CubeOptions,
+    ) {
+        let budget = options.texel_budget;
+        let sizes = match options.sizes {
+            FaceSizes::Equal => equal_sizes(self.faces.len(), budget),
+            FaceSizes::ByNeed => {
+                let at = self.position.as_dvec3();
+                let needs: ArrayVec<Option<[f64; 2]>, 6> =
+                    predicted_needs(&self.faces, at, camera, receivers)
+                        .into_iter()
+                        .map(|n| n.map(|n| [n, n]))
+                        .collect();
+                sizes_by_need(&needs, budget)
+            }
+        };
+        self.set_sizes(&sizes);
+    }
+
+    /// Shares `budget` texels between the faces in proportion to `needs` (in face
+    /// order: the texel density each face needs along its `u` and `v`, in any unit
+    /// common to all; `None` for a face without an estimate) as
+    /// [`FaceSizes::ByNeed`] does, and packs the atlas. For a renderer with a better
+    /// estimate of the needs than the receivers' box (RTW's importance, say).
+    pub fn set_sizes_by_need(&mut self, needs: &[Option<[f64; 2]>], budget: u64) {
+        let sizes = sizes_by_need(needs, budget);
+        self.set_sizes(&sizes);
+    }
+
+    /// Sets the faces' map sizes (width, height; in face order, a missing one keeps
+    /// its size) and packs them into the atlas: shelves of maps, the highest first.
+    /// A packing past the largest texture side falls back to equal squares of the
+    /// same total area.
+    pub fn set_sizes(&mut self, sizes: &[[u32; 2]]) {
+        for (f, s) in self.faces.iter_mut().zip(sizes) {
+            f.size = s.map(|x| x.max(1));
+        }
+        let current: ArrayVec<Size, 6> = self.faces.iter().map(|f| f.size).collect();
+        let (offsets, atlas) = match pack(&current) {
+            (offsets, Some(atlas)) => (offsets, atlas),
+            (_, None) => {
+                let total: u64 = current.iter().map(|s| crate::cube_sizes::area(*s)).sum();
+                let equal = equal_sizes(current.len(), total);
+                for (f, s) in self.faces.iter_mut().zip(&equal) {
+                    f.size = *s;
+                }
+                let (offsets, atlas) = pack(&equal);
+                (offsets, atlas.unwrap_or([0, 0]))
+            }
+        };
+        for (f, o) in self.faces.iter_mut().zip(offsets) {
+            f.offset = o;
+        }
+        self.atlas = atlas;
+    }
+
+    /// Texels of the atlas (what the map costs, gaps between faces included).
+    #[must_use]
+    pub fn texels(&self) -> u64 {
+        crate::cube_sizes::area(self.atlas)
+    }
+
+    /// The largest side of a kept face, in texels (0 without faces): the layer side
+    /// of a texture array that stores each face in a corner of its layer
+    /// ([`CubeFace::clip_from_world_in_layer`]).
+    #[must_use]
+    pub fn largest_side(&self) -> u32 {
+        self.faces
+            .iter()
+            .map(|f| f.size[0].max(f.size[1]))
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Whether every kept face has the same square size: the faces can be the
+    /// layers of a texture array (the atlas is a column of them).
+    #[must_use]
+    pub fn has_equal_faces(&self) -> bool {
+        self.faces.iter().all(|f| f.size[0] == f.size[1])
+            && self.faces.windows(2).all(|w| w[0].size == w[1].size)
+    }
+
+    /// A sample of [`ShadowMapping::map_point`] (a face's `uv`, its layer) in the
+    /// atlas's texture coordinates, layer 0; `None` for a layer past the last face.
+    ///
+    /// ```text
+    /// uv_atlas = (offset + uv * size) / atlas
+    /// ```
+    #[must_use]
+    pub fn atlas_sample(&self, sample: ShadowSample) -> Option<ShadowSample> {
+        let f = self.faces.get(sample.layer as usize)?;
+        let pair = |p: [u32; 2]| DVec2::new(f64::from(p[0]), f64::from(p[1]));
+        let uv = (pair(f.offset) + sample.uv * pair(f.size)) / pair(self.atlas);
+        uv.is_finite().then_some(ShadowSample {
+            uv,
+            layer: 0,
+            ..sample
+        })
+    }
+}
+
+impl CubeFace {
+    /// The face's texels as a fraction of a square texture-array layer of
+    /// `layer_side` texels per side (`size / layer_side`, at most 1 per axis): a
+    /// backend that stores faces of different sizes as layers of the largest face's
+    /// side draws each face into the layer's top-left corner of this extent and
+    /// scales the face's `uv` by it when it reads the layer.
+    #[must_use]
+    pub fn uv_scale_in_layer(&self, layer_side: u32) -> Vec2 {
+        let side = f64::from(layer_side.max(1));
+        let scale = |texels: u32| (f64::from(texels) / side).clamp(f64::MIN_POSITIVE, 1.0);
+        DVec2::new(scale(self.size[0]), scale(self.size[1])).as_vec2()
+    }
+
+    /// [`CubeFace::clip_from_world`] followed by the map of the face's window onto
+    /// the top-left corner of a layer of `layer_side` texels
+    /// ([`CubeFace::uv_scale_in_layer`]), so each face keeps its own texel density
+    /// in a texture array of one side:
+    ///
+    /// ```text
+    /// s = size / layer_side
+    /// ndc'.x = s.x ndc.x + s.x - 1       uv'.x = s.x uv.x
+    /// ndc'.y = s.y ndc.y + 1 - s.y       uv'.y = s.y uv.y
+    /// ```
+    ///
+    /// Geometry beyond the window lands in the rest of the layer, where the face's
+    /// own projection continues: a filter that reaches past the window's edge reads
+    /// depths of the same projection, not of another face.
+    #[must_use]
+    pub fn clip_from_world_in_layer(&self, layer_side: u32) -> Mat4 {
+        let s = self.uv_scale_in_layer(layer_side).as_dvec2();
+        let corner_from_clip = DMat4::from_cols(
+            DVec4::new(s.x, 0.0, 0.0, 0.0),
+            DVec4::new(0.0, s.y, 0.0, 0.0),
+            DVec4::Z,
+            DVec4::new(s.x - 1.0, 1.0 - s.y, 0.0, 1.0),
+        );
+        (corner_from_clip * self.clip_from_world.as_dmat4()).as_mat4()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn equal_sizes_make_a_column() {
+        let sizes = equal_sizes(6, 1024 * 1024);
+        assert_eq!(sizes.as_slice(), &[[418, 418]; 6]);
+        let (offsets, atlas) = pack(&sizes);
+        assert_eq!(atlas, Some([418, 6 * 418]));
+        for (i, o) in offsets.iter().enumerate() {
+            assert_eq!(*o, [0, 418 * i as u32]);
+        }
+    }
+
+    /// Maps do not overlap and lie in the atlas.
+    fn check_packing(sizes: &[Size]) {
+        let (offsets, atlas) = pack(sizes);
+        let atlas = atlas.unwrap();
+        for (i, (a, sa)) in offsets.iter().zip(sizes).enumerate() {
+            assert!(
+                a[0] + sa[0] <= atlas[0] && a[1] + sa[1] <= atlas[1],
+                "{sizes:?}"
+            );
+            for (b, sb) in offsets.iter().zip(sizes).skip(i + 1) {
+                let apart = a[0] + sa[0] <= b[0]
+                    || b[0] + sb[0] <= a[0]
+                    || a[1] + sa[1] <= b[1]
+                    || b[1] + sb[1] <= a[1];
+                assert!(apart, "{sizes:?}: {offsets:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn shelves_hold_every_map_apart() {
+        for sizes in [
+            vec![[300, 300], [100, 100], [100, 100], [100, 100], [100, 100]],
+            vec![[10, 10], [200, 50], [7, 90], [199, 199], [64, 64], [64, 8]],
+            vec![[5, 5]],
+            vec![[90, 30], [90, 90], [30, 30], [30, 90], [30, 30], [30, 30]],
+        ] {
+            check_packing(&sizes);
+        }
+    }
+
+    #[test]
+    fn sizes_follow_the_needs_within_the_budget() {
+        let budget = 1024 * 1024;
+        let needs = [
+            Some([3.0, 3.0]),
+            Some([1.0, 1.0]),
+            Some([2.0, 1.0]),
+            None,
+            Some([1.0, 1.0]),
+            Some([0.01, 0.01]),
+        ];
+        let sizes = sizes_by_need(&needs, budget);
+        let (_, atlas) = pack(&sizes);
+        let texels = area(atlas.unwrap());
+        assert!(texels <= budget && texels > budget * 8 / 10, "{texels}");
+        // Three times the need, three times the side (up to rounding); twice the
+        // need along u, twice the width; the face without a need and the one below
+        // the floor get the floor.
+        assert!((f64::from(sizes[0][0]) / f64::from(sizes[1][0]) - 3.0).abs() < 0.05);
+        assert!((f64::from(sizes[2][0]) / f64::from(sizes[2][1]) - 2.0).abs() < 0.05);
+        let floor = (f64::from(sizes[0][0]) * MIN_SIDE_RATIO) as u32;
+        assert!(sizes[3][0].abs_diff(floor) <= 1 && sizes[5][1].abs_diff(floor) <= 1);
+        check_packing(&sizes);
+        // An extreme aspect is limited.
+        let thin = sizes_by_need(&[Some([1.0, 1e-4])], budget);
+        assert!((f64::from(thin[0][1]) / f64::from(thin[0][0]) - MIN_ASPECT).abs() < 0.01);
+        // Equal needs: equal squares, as `equal_sizes` (up to the last texel).
+        let same = sizes_by_need(&[Some([2.0, 2.0]); 6], budget);
+        assert!(
+            same.iter().flatten().all(|s| s.abs_diff(418) <= 1),
+            "{same:?}"
+        );
+        // No need at all: equal sizes.
+        assert_eq!(sizes_by_need(&[None, None], budget), equal_sizes(2, budget));
+    }
+}

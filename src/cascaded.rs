@@ -1,0 +1,246 @@
+//! The cascaded techniques of [`fit`](crate::fit): stable, tight and warped
+//! cascades, their count from the predicted error, and their light frame.
+
+use arrayvec::ArrayVec;
+use glam::{DVec3, Vec3};
+use shadowmap_frustum::{
+    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, MAX_CASCADES,
+    ShadowMapping, ShadowSample, SplitScheme, ValidCamera,
+};
+use shadowmap_warp::{LispsmOptions, WarpedCascades, light_frame, warped_cascades};
+
+use crate::fit::{FitError, FitInput, predicted_percentiles};
+use crate::shadow::Fitted;
+use crate::technique::CascadePlan;
+
+/// Stable or tight cascades (PSSM over the depth bounds), their count chosen by
+/// [`choose_splits`] and kept in `state` with the stable maps' extents.
+pub(crate) fn fit_cascades(
+    plan: &CascadePlan,
+    stable: bool,
+    direction: Vec3,
+    input: &FitInput<'_>,
+    state: &mut CascadeState,
+) -> Result<(Fitted, u32), FitError> {
+    let camera = ValidCamera::new(input.camera)?;
+    let mut count = state.count();
+    let tight = |splits: &CascadeSplits, k: u32| -> Option<Candidate> {
+        let options = cascade_options(input, k, direction).ok()?;
+        let set = CascadeSet::fit_valid(&camera, direction, splits, &options).ok()?;
+        Some(Candidate::Cascades(set))
+    };
+    let splits = choose_splits(plan, input, &camera, &mut count, &tight)?;
+    state.set_count(count);
+    let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
+    let fit = cascade_options(input, layers, direction)?
+        .with_reversed_z(plan.reversed_z)
+        .with_fit(if stable {
+            CascadeFit::Stable
+        } else {
+            CascadeFit::Tight
+        });
+    let set = CascadeSet::fit_with_state(&camera, direction, &splits, &fit, state)?;
+    Ok((Fitted::Cascades(set), layers))
+}
+
+/// Warped cascades (PSSM with LiSPSM per slice) over the depth bounds, their count
+/// chosen by [`choose_splits`] on their own predicted error (a warp changes which
+/// split pays: one warped map over a short range can beat four) and kept in
+/// `state` (its count only: warped maps are not held).
+pub(crate) fn fit_warped(
+    plan: &CascadePlan,
+    options: &LispsmOptions,
+    direction: Vec3,
+    input: &FitInput<'_>,
+    state: &mut CascadeState,
+) -> Result<(Fitted, u32), FitError> {
+    let camera = ValidCamera::new(input.camera)?;
+    let etas = [options.eta; MAX_CASCADES];
+    let fit = |splits: &CascadeSplits| {
+        warped_cascades(
+            input.camera,
+            direction,
+            &input.scene,
+            splits,
+            etas.get(..splits.count()).unwrap_or(&[]),
+            options,
+        )
+    };
+    let (eye, forward) = (input.camera.eye(), input.camera.forward());
+    let warped = |splits: &CascadeSplits, _: u32| -> Option<Candidate> {
+        Some(Candidate::Warped(fit(splits).ok()?, eye, forward))
+    };
+    let mut count = state.count();
+    let splits = choose_splits(plan, input, &camera, &mut count, &warped)?;
+    state.set_count(count);
+    let cascades = fit(&splits)?;
+    let fitted = Fitted::WarpedCascades {
+        cascades,
+        eye,
+        forward,
+    };
+    Ok((fitted, u32::try_from(splits.count()).unwrap_or(u32::MAX)))
+}
+
+/// The options of `count` cascades (tight unless changed): a map side that shares
+/// the budget, the scene bounds, and the light frame's orientation
+/// ([`cascade_up`]).
+fn cascade_options(
+    input: &FitInput<'_>,
+    count: u32,
+    direction: Vec3,
+) -> Result<CascadeOptions, FitError> {
+    Ok(CascadeOptions::default()
+        .with_resolution(input.layer_side(count))
+        .with_scene(Some(input.scene))
+        .with_fit(CascadeFit::Tight)
+        .with_up_hint(cascade_up(input.camera, direction, count)?))
+}
+
+/// The up vector that orients the light frame of `count` cascades (the stable
+/// cascades take it when they (re)size a map and then hold it, see
+/// [`CascadeState`]).
+///
+/// One cascade fits in the frame of the uniform fit and the warps
+/// ([`light_frame`]: the view direction made perpendicular to the light, blended
+/// continuously with the camera's up where the light nears the view axis), so that
+/// one tight cascade over the camera's whole depth range is the uniform fit, and a
+/// narrower depth range can only shrink it: one cascade is never worse than the
+/// uniform fit.
+///
+/// More cascades fit in the frame lined up with the image: its x axis is the
+/// camera's right vector made perpendicular to the light. A slice of the frustum
+/// seen along the light is a trapezoid lined up with the view direction when the
+/// light is overhead, and nearly a rectangle lined up with the image rows when the
+/// light is near the view direction; the camera's right vector is an axis of both,
+/// where the view direction made perpendicular to the light turns about the light
+/// as the light nears the view axis and tilts the box against the slice (up to 30%
+/// more texels per side in the report's configurations). This frame is undefined
+/// only for a light travelling along the camera's right vector (level, from the
+/// side), where it falls back to a world axis (see
+/// `shadowmap_frustum::light_rotation`).
+fn cascade_up(camera: &Camera, direction: Vec3, count: u32) -> Result<Vec3, FitError> {
+    if count <= 1 {
+        let m = light_frame(camera, direction)?;
+        return Ok(Vec3::new(m.x_axis.y, m.y_axis.y, m.z_axis.y));
+    }
+    let d = direction.normalize_or_zero();
+    let right = camera.world_from_view.x_axis.truncate().normalize_or_zero();
+    Ok((right - d * right.dot(d)).cross(d))
+}
+
+/// A count kept from the previous frame stays while its predicted error is within
+/// this factor of the best count's (see [`choose_splits`]).
+const COUNT_KEEP_RATIO: f64 = 1.1;
+
+/// More than one cascade is chosen only where it is predicted at most this times
+/// the error of one (see [`choose_splits`]), as a warp keeps its strength only
+/// where it is predicted clearly better than the uniform fit: where the two are
+/// close the prediction cannot tell them apart, and one map is the safe side.
+const COUNT_GAIN: f64 = 0.9;
+
+/// One fitted count of a cascaded technique, as the prediction sees it.
+#[expect(
+    clippy::large_enum_variant,
+    reason = "inline cascades keep the count choice allocation-free"
+)]
+enum Candidate {
+    Cascades(CascadeSet),
+    /// The cascades, the camera's eye and viewing direction.
+    Warped(WarpedCascades, Vec3, Vec3),
+}
+
+impl ShadowMapping for Candidate {
+    fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
+        match self {
+            Self::Cascades(set) => set.map_point(world),
+            Self::Warped(cascades, eye, forward) => cascades.view(*eye, *forward).map_point(world),
+        }
+    }
+}
+
+/// Splits of a cascaded technique: practical splits of the depth bounds (the
+/// camera's range without them), so no cascade covers empty depth, into the count
+/// of least predicted error.
+///
+/// For each count `k` up to `plan.max_cascades` (only those whose map side is a
+/// power of two when there are any: the stable fit's whole-texel motion is exact
+/// in `f32` only there), `fit(splits, k)` fits the technique on `side(k)` texels
+/// (the tight and stable cascades are predicted by their tight fit, in the frame of
+/// [`cascade_up`]), and the 95th percentile of the aliasing error is predicted on
+/// the same rays for every count (`shadowmap_frustum::predict_errors`, the error
+/// model of Lloyd et al. over the receivers' box within the depth bounds: camera,
+/// light and bounds alone, no rendering). One cascade is the uniform fit (or the
+/// warp) narrowed to the depth bounds, and more are chosen only where predicted at
+/// most [`COUNT_GAIN`] times its error, so the chosen count is never predicted
+/// worse than one map. Over open ground the footprint grows with depth and more
+/// cascades win (Zhang et al.'s reasoning for parallel splits); in a room, where
+/// the walls bound what is seen, the near cascades' gain does not pay for the far
+/// ones' smaller maps and one map wins. The count of the previous frame (`kept`) is
+/// kept while its prediction is within [`COUNT_KEEP_RATIO`] of the best, so a view
+/// near the boundary between two counts does not re-size every map from one frame
+/// to the next; `kept` is set to the count chosen. Where no count can be predicted
+/// (no ray meets the receivers), the kept count stays, or one cascade.
+fn choose_splits(
+    plan: &CascadePlan,
+    input: &FitInput<'_>,
+    camera: &ValidCamera,
+    kept: &mut usize,
+    fit: &dyn Fn(&CascadeSplits, u32) -> Option<Candidate>,
+) -> Result<CascadeSplits, FitError> {
+    let (near, far) = match input.depth_bounds {
+        Some(bounds) => bounds.clamped_to_valid(camera),
+        None => camera.depth_range(),
+    };
+    let max = plan.max_cascades.clamp(1, MAX_CASCADES);
+    let side = |k: usize| input.layer_side(u32::try_from(k).unwrap_or(u32::MAX));
+    let any_power = (1..=max).any(|k| side(k).is_power_of_two());
+    let allowed = |k: usize| (1..=max).contains(&k) && (!any_power || side(k).is_power_of_two());
+    let scheme = SplitScheme::Practical {
+        lambda: plan.split_lambda,
+    };
+    let splits_of = |k: usize| -> Result<CascadeSplits, FitError> {
+        Ok(CascadeSplits::new(&scheme, k, near, far)?.with_overlap(plan.overlap)?)
+    };
+    let mut candidates: ArrayVec<(usize, Candidate), MAX_CASCADES> = ArrayVec::new();
+    for k in (1..=max).filter(|k| allowed(*k)) {
+        let count = u32::try_from(k).unwrap_or(u32::MAX);
+        if let Some(c) = fit(&splits_of(k)?, count) {
+            candidates.push((k, c));
+        }
+    }
+    let mut scores = predicted_errors(input, &candidates)?;
+    for score in scores.iter_mut().skip(2) {
+        *score /= COUNT_GAIN;
+    }
+    let best = (1..=max)
+        .filter(|k| allowed(*k) && scores[*k].is_finite())
+        .min_by(|a, b| scores[*a].total_cmp(&scores[*b]).then(a.cmp(b)));
+    let keep = allowed(*kept) && best.is_none_or(|b| scores[*kept] <= scores[b] * COUNT_KEEP_RATIO);
+    if !keep {
+        *kept = best.unwrap_or(1);
+    }
+    splits_of(*kept)
+}
+
+/// The predicted 95th-percentile error of each candidate count (index `k`;
+/// infinite where a count has no candidate or no prediction), all on the same rays.
+fn predicted_errors(
+    input: &FitInput<'_>,
+    candidates: &[(usize, Candidate)],
+) -> Result<[f64; MAX_CASCADES + 1], FitError> {
+    let mut mappings: ArrayVec<(&dyn ShadowMapping, u32), MAX_CASCADES> = ArrayVec::new();
+    for (k, candidate) in candidates {
+        let side = input.layer_side(u32::try_from(*k).unwrap_or(u32::MAX));
+        mappings.push((candidate as &dyn ShadowMapping, side));
+    }
+    let mut predicted = [None; MAX_CASCADES];
+    predicted_percentiles(input, &mappings, &mut predicted)?;
+    let mut scores = [f64::INFINITY; MAX_CASCADES + 1];
+    for ((k, _), p) in candidates.iter().zip(predicted) {
+        if let (Some(p), Some(score)) = (p, scores.get_mut(*k)) {
+            *score = p;
+        }
+    }
+    Ok(scores)
+}

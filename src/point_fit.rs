@@ -1,0 +1,386 @@
+//! The fits of RTW over the point-light bases: each side of the IPSM paraboloid, and
+//! each focused face of the cube map.
+
+use alloc::vec::Vec;
+
+use arrayvec::ArrayVec;
+use glam::DVec3;
+use shadowmap_frustum::math::sqrt;
+use shadowmap_frustum::{LightDirection, ShadowMapping};
+use shadowmap_paraboloid::{CubeMap, CubeOptions, FaceSizes, IpsmOptions, IpsmPlan, Side};
+use shadowmap_rtw::{AxisNeed, BasePoint, EyeSample, ImportanceMap, WarpMaps, oracle_needs};
+
+use crate::fit::{FitError, FitInput, layer_side};
+use crate::sample_error::{MAX_SAMPLES, percentile_of, sample_error};
+use crate::shadow::Fitted;
+use crate::technique::RtwPlan;
+
+/// The eye samples, which RTW requires.
+fn eye_samples<'a>(
+    input: &FitInput<'a>,
+    technique: &'static str,
+) -> Result<&'a [EyeSample], FitError> {
+    input.eye_samples.ok_or(FitError::MissingInput {
+        technique,
+        input: "eye_samples",
+    })
+}
+
+/// RTW over the IPSM paraboloid: per side, importance from the eye samples that side
+/// stores, in its `uv`, scaled by the paraboloid's footprint there (world extent of a
+/// unit of `uv` across the ray: `distance / sqrt(uv² per steradian)`), then that
+/// side's tables.
+pub(crate) fn fit_point_rtw(
+    ipsm: &IpsmOptions,
+    plan: &RtwPlan,
+    input: &FitInput<'_>,
+) -> Result<Fitted, FitError> {
+    let samples = eye_samples(input, "point_rtw")?;
+    let ipsm = IpsmPlan::new(input.light, input.camera, input.depth_bounds, ipsm)?;
+    let map = ipsm.map;
+    let n = plan.importance_side;
+    let side_warps = |side: Side| -> Result<WarpMaps, FitError> {
+        let project = |p: DVec3| {
+            let s = map.map_point(p).filter(|s| s.layer == side.layer())?;
+            let world = p.as_vec3();
+            let per_sr = f64::from(map.texels_per_steradian(world, 1)?);
+            let toward_light = map.position.as_dvec3() - p;
+            Some(BasePoint {
+                uv: s.uv,
+                footprint: toward_light.length() / sqrt(per_sr),
+                toward_light,
+            })
+        };
+        let mut importance = ImportanceMap::new(n, n)?;
+        importance.accumulate_backward_with(project, samples, None, &plan.importance)?;
+        let mut warps = WarpMaps::new(n, n)?;
+        warps.build(&importance, &plan.warp)?;
+        Ok(warps)
+    };
+    let front = side_warps(Side::Front)?;
+    let back = if map.layers() == 2 {
+        Some(side_warps(Side::Back)?)
+    } else {
+        None
+    };
+    Ok(Fitted::PointRtw {
+        plan: ipsm,
+        front,
+        back,
+    })
+}
+
+/// IPSM. With the eye samples and pixels per radian, the plan's map is measured on
+/// them ([`sample_error`]) against its dual alternatives, the dual map of the plan's
+/// own seam and the dual map of a DPSM's fixed axis (`-up_hint`), each at the
+/// budget's side for its layer count, and the finest is kept: the plan's own
+/// decision rests on the frustum's corners, which can favour a seam or a cut that
+/// the visible surfaces do not.
+pub(crate) fn fit_ipsm(options: &IpsmOptions, input: &FitInput<'_>) -> Result<IpsmPlan, FitError> {
+    let plan = IpsmPlan::new(input.light, input.camera, input.depth_bounds, options)?;
+    let (Some(samples), Some(ppr)) = (input.eye_samples, input.pixels_per_radian) else {
+        return Ok(plan);
+    };
+    let error = |p: &IpsmPlan| {
+        let side = f64::from(layer_side(input.texel_budget, p.map.layers()));
+        sample_error(
+            &p.map,
+            &|_| side,
+            input.camera,
+            ppr,
+            samples,
+            LightDirection::Position(p.map.position),
+            NEED_PERCENTILE,
+        )
+        .unwrap_or(f64::INFINITY)
+    };
+    let mut best = (error(&plan), plan);
+    for axis in [None, Some(-options.up_hint)] {
+        if let Ok(alternative) = plan.with_dual(axis, options) {
+            let e = error(&alternative);
+            if e < best.0 {
+                best = (e, alternative);
+            }
+        }
+    }
+    Ok(best.1)
+}
+
+/// Cube maps. With [`FaceSizes::ByNeed`] and the eye samples and pixels per radian,
+/// each face's side follows the 95th percentile over the samples it stores of the
+/// density they need (the oracle's isotropic requirement, [`oracle_needs`], with
+/// the true normal where the light reaches the surface from the front: the error
+/// `m` of a face of one texel per side), instead of the prediction on the
+/// receivers' box, which misjudges a face when the box is far from the surfaces
+/// (a terrain's box reaches the sky).
+pub(crate) fn fit_cube(options: &CubeOptions, input: &FitInput<'_>) -> Result<CubeMap, FitError> {
+    let mut cube = fit_faces(options, input)?;
+    if let (FaceSizes::ByNeed, Some(samples), Some(ppr)) =
+        (options.sizes, input.eye_samples, input.pixels_per_radian)
+    {
+        let mut needs: ArrayVec<Option<[f64; 2]>, 6> = ArrayVec::new();
+        let stride = samples.len().div_ceil(MAX_SAMPLES).max(1);
+        for layer in 0..cube.layers() {
+            let mut errors: ArrayVec<f64, MAX_SAMPLES> = ArrayVec::new();
+            if let Some(base) = cube.transform(layer) {
+                oracle_needs(&base, input.camera, ppr, samples, |i, need| {
+                    let stored = cube
+                        .map_point(samples[i].position.as_dvec3())
+                        .is_some_and(|s| s.layer == layer);
+                    if stored && i % stride == 0 {
+                        let _ = errors.try_push(need.isotropic);
+                    }
+                })?;
+            }
+            needs.push(percentile(&mut errors).map(|m| [m, m]));
+        }
+        if needs.iter().any(Option::is_some) {
+            cube.set_sizes_by_need(&needs, input.texel_budget);
+        }
+    }
+    Ok(cube)
+}
+
+/// Margin of a face's window around its samples, as a fraction of their extent.
+const SAMPLE_MARGIN: f64 = 0.01;
+
+/// Narrows each face's window to the bounding rectangle of the samples it stores
+/// (with [`SAMPLE_MARGIN`]): the warp's tables then spend their cells on what the
+/// eye sees. A face without samples keeps its window.
+fn narrow_to_samples(cube: &mut CubeMap, samples: &[EyeSample]) -> Result<(), FitError> {
+    let mut boxes = [(glam::DVec2::INFINITY, glam::DVec2::NEG_INFINITY); 6];
+    for s in samples {
+        if let Some(x) = cube.map_point(s.position.as_dvec3()) {
+            if let Some((lo, hi)) = boxes.get_mut(x.layer as usize) {
+                *lo = lo.min(x.uv);
+                *hi = hi.max(x.uv);
+            }
+        }
+    }
+    for (layer, (lo, hi)) in (0..cube.layers()).zip(boxes) {
+        let margin = (hi - lo) * SAMPLE_MARGIN + 1e-6;
+        cube.narrow_to_uv(layer, lo - margin, hi + margin)?;
+    }
+    Ok(())
+}
+
+/// The cube map of `options` fitted to the frame, over the input's texel budget.
+fn fit_faces(options: &CubeOptions, input: &FitInput<'_>) -> Result<CubeMap, FitError> {
+    let options = options.with_texel_budget(input.texel_budget);
+    Ok(CubeMap::fit(
+        input.light,
+        input.camera,
+        input.depth_bounds,
+        &input.scene,
+        &options,
+    )?)
+}
+
+/// The needs ([`oracle_needs`]) of the samples stored in a cube's `layer` for which
+/// `keep` holds, into `out` (cleared first).
+fn stored_needs(
+    cube: &CubeMap,
+    layer: u32,
+    camera: &shadowmap_frustum::Camera,
+    pixels_per_radian: f32,
+    samples: &[EyeSample],
+    out: &mut Vec<AxisNeed>,
+    mut keep: impl FnMut(&AxisNeed) -> bool,
+) -> Result<(), FitError> {
+    out.clear();
+    let Some(base) = cube.transform(layer) else {
+        return Ok(());
+    };
+    oracle_needs(&base, camera, pixels_per_radian, samples, |i, need| {
+        let stored = cube
+            .map_point(samples[i].position.as_dvec3())
+            .is_some_and(|s| s.layer == layer);
+        if stored && keep(&need) {
+            out.push(need);
+        }
+    })?;
+    Ok(())
+}
+
+/// The [`NEED_PERCENTILE`] of `values` (reordered), `None` when empty or not
+/// positive and finite.
+fn percentile(values: &mut [f64]) -> Option<f64> {
+    percentile_of(values, NEED_PERCENTILE)
+}
+
+/// RTW over the focused faces of a cube map: per kept face, each eye sample the face
+/// stores asks for the texel density it needs along the face's `u` and `v` (the
+/// oracle's exact requirement, [`oracle_needs`]: the screen-to-texture Jacobian
+/// through its surface, with its own normal where it is lit from the front, the
+/// bisector of the eye and light directions elsewhere, since shading darkens those
+/// surfaces whatever the map holds); the column maxima of the `u` needs and the row
+/// maxima of the `v` needs build the face's tables. The faces then share the budget:
+/// each face's width and height in proportion to the 95th percentile, over its
+/// samples, of the need left after the warp's magnification along that axis, so
+/// that every face and axis is predicted to reach the same error.
+pub(crate) fn fit_cube_rtw(
+    options: &CubeOptions,
+    plan: &RtwPlan,
+    input: &FitInput<'_>,
+) -> Result<Fitted, FitError> {
+    let samples = eye_samples(input, "cube_rtw")?;
+    let pixels_per_radian = input.pixels_per_radian.ok_or(FitError::MissingInput {
+        technique: "cube_rtw",
+        input: "pixels_per_radian",
+    })?;
+    let mut cube = fit_faces(&options.with_sizes(FaceSizes::Equal), input)?;
+    narrow_to_samples(&mut cube, samples)?;
+    let n = plan.importance_side;
+    let (mut map_u, mut map_v) = (ImportanceMap::new(n, n)?, ImportanceMap::new(n, n)?);
+    let mut warps = Vec::with_capacity(cube.faces.len());
+    let mut needs: ArrayVec<Option<[f64; 2]>, 6> = ArrayVec::new();
+    let mut face_needs: Vec<AxisNeed> = Vec::new();
+    for layer in 0..cube.layers() {
+        map_u.clear();
+        map_v.clear();
+        stored_needs(
+            &cube,
+            layer,
+            input.camera,
+            pixels_per_radian,
+            samples,
+            &mut face_needs,
+            |n| map_u.splat_need(n.uv, n.u) && map_v.splat_need(n.uv, n.v),
+        )?;
+        let mut w = WarpMaps::new(n, n)?;
+        w.build_separable(&map_u, &map_v, &plan.warp)?;
+        needs.push(left_after_warp(&w, &face_needs));
+        warps.push(w);
+    }
+    cube.set_sizes_by_need(&needs, input.texel_budget);
+    Ok(Fitted::CubeRtw { cube, warps })
+}
+
+/// Share of a face's samples whose need decides its size.
+const NEED_PERCENTILE: f64 = 0.95;
+
+/// The [`NEED_PERCENTILE`] of the needs along `u` and `v` over the warp's
+/// magnification (the error each axis keeps on a map of one texel per side);
+/// `None` without needs.
+fn left_after_warp(warps: &WarpMaps, needs: &[AxisNeed]) -> Option<[f64; 2]> {
+    let axis = |along: fn(&AxisNeed, glam::DVec2) -> f64| {
+        let mut left: Vec<f64> = needs
+            .iter()
+            .map(|n| along(n, warps.magnification(n.uv)))
+            .collect();
+        percentile(&mut left)
+    };
+    Some([axis(|n, m| n.u / m.x)?, axis(|n, m| n.v / m.y)?])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Technique, fit};
+    use glam::Vec3;
+    use proptest::prelude::*;
+    use shadowmap_frustum::SceneBounds;
+    use shadowmap_testgen::point_rtw::{
+        CubeSamplesCase, PointRtwCase, check_cube_samples, check_point_rtw, cube_samples_case,
+        point_rtw_case,
+    };
+    use shadowmap_testgen::strategy;
+
+    /// Fits RTW over the paraboloid to a case and checks its coverage; the number of
+    /// samples checked (0 when the fit refuses the case, e.g. a spot light).
+    fn fit_and_check(case: &PointRtwCase) -> usize {
+        let input = FitInput::new(
+            &case.plan.camera,
+            &case.plan.light,
+            // IPSM reads the camera and depth bounds, not the scene.
+            SceneBounds::whole(shadowmap_frustum::Aabb::new(Vec3::splat(-1.0), Vec3::ONE)),
+            1 << 16,
+        )
+        .with_eye_samples(&case.samples)
+        .with_depth_bounds(case.plan.bounds);
+        let technique = Technique::PointRtw {
+            ipsm: case.plan.options,
+            rtw: RtwPlan::default().with_importance_side(32),
+        };
+        let Ok(shadow) = fit(&technique, &input) else {
+            return 0;
+        };
+        let Fitted::PointRtw { plan, .. } = shadow.fitted() else {
+            panic!("point_rtw fitted something else");
+        };
+        assert_eq!(shadow.layers(), plan.map.layers());
+        check_point_rtw(case, &plan.map, &shadow)
+    }
+
+    /// Fits the cube maps (faces sized by the samples' needs) or RTW over their faces
+    /// to a case and checks coverage of the samples; the number checked (0 when the
+    /// fit refuses the case: nothing visible in range).
+    fn fit_cube_and_check(case: &CubeSamplesCase, warped: bool) -> Result<usize, String> {
+        let c = &case.cube;
+        let budget = 1 << 16;
+        let input = FitInput::new(&c.camera, &c.light, c.scene, budget)
+            .with_eye_samples(&case.samples)
+            .with_depth_bounds(c.bounds)
+            .with_pixels_per_radian(case.pixels_per_radian);
+        let technique = if warped {
+            Technique::CubeRtw {
+                cube: c.options,
+                rtw: RtwPlan::default().with_importance_side(32),
+            }
+        } else {
+            Technique::CubeMaps(c.options.with_sizes(FaceSizes::ByNeed))
+        };
+        let Ok(shadow) = fit(&technique, &input) else {
+            return Ok(0);
+        };
+        let cube = shadow.cube().ok_or("not a cube map")?;
+        if let Fitted::CubeRtw { warps, .. } = shadow.fitted() {
+            assert_eq!(warps.len(), cube.faces.len());
+        }
+        assert_eq!(shadow.texels(), cube.texels());
+        check_cube_samples(case, cube, &shadow, budget)
+    }
+
+    /// The property below checks samples on most generated cases, with and without
+    /// the warp (not a generator whose fits all fail).
+    #[test]
+    fn cube_cases_reach_fitted_maps() {
+        use shadowmap_testgen::arbitrary::Unstructured;
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let (mut fitted, mut checked) = (0, 0);
+        for _ in 0..300 {
+            let bytes = shadowmap_testgen::xorshift_bytes(&mut state, 512);
+            let Ok(case) = cube_samples_case(&mut Unstructured::new(&bytes)) else {
+                continue;
+            };
+            for warped in [false, true] {
+                let n = fit_cube_and_check(&case, warped).unwrap();
+                fitted += usize::from(n > 0);
+                checked += n;
+            }
+        }
+        assert!(
+            fitted > 300 && checked > 10_000,
+            "{fitted} fits, {checked} samples"
+        );
+    }
+
+    proptest! {
+        #![proptest_config(shadowmap_testgen::proptest_config())]
+
+        /// Cube maps sized by the samples' needs, and RTW over their faces (windows
+        /// narrowed to the samples), store every sample: with the light inside the
+        /// view, next to it, far away, inside a caster's bounds.
+        #[test]
+        fn cube_faces_cover_their_samples(case in strategy(cube_samples_case), warped: bool) {
+            fit_cube_and_check(&case, warped).map_err(TestCaseError::fail)?;
+        }
+
+        /// Every sample the IPSM paraboloid stores is stored by RTW over it, in the
+        /// same layer, with the same depth, inside the map.
+        #[test]
+        fn point_rtw_covers_what_the_paraboloid_covers(case in strategy(point_rtw_case)) {
+            fit_and_check(&case);
+        }
+    }
+}
