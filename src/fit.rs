@@ -6,7 +6,7 @@ use core::fmt;
 use glam::Vec3;
 use shadowmap_frustum::math::{floor, sqrt};
 use shadowmap_frustum::{
-    Camera, CascadeState, DepthBounds, FRONT_LIT_MIN_COS, FrustumError, Light,
+    Camera, CascadeState, DepthBounds, FRONT_LIT_MIN_COS, FrustumError, Light, LightDirection,
     MAX_PREDICT_CANDIDATES, PredictOptions, PredictedError, SceneBounds, ShadowMapping,
     ShadowTransform, TechniqueSelector, fit_spot, predict_errors,
 };
@@ -431,37 +431,50 @@ fn fit_rtw(
     } else {
         match *input.light {
             Light::Directional { direction } => {
-                let lit = front_lit(samples, direction);
+                let light = LightDirection::Directional(direction);
+                let lit = front_lit(samples, light);
                 map.accumulate_backward(&base, &lit, None, &plan.importance)?;
                 crate::rtw_strength::build_measured(
-                    &base, &map, &lit, camera, direction, &plan.warp, &mut warps,
+                    &base, &map, &lit, camera, light, &plan.warp, &mut warps,
                 )?;
-                return Ok(Fitted::Rtw { base, warps });
             }
-            _ => {
+            Light::Spot { position, .. } => {
+                let light = LightDirection::Position(position);
+                let lit = front_lit(samples, light);
+                map.accumulate_backward(&base, &lit, None, &plan.importance)?;
+                crate::rtw_strength::build_measured(
+                    &base, &map, &lit, camera, light, &plan.warp, &mut warps,
+                )?;
+            }
+            Light::Point { .. } => {
                 map.accumulate_backward(&base, samples, None, &plan.importance)?;
+                warps.build(&map, &plan.warp)?;
             }
         }
-        warps.build(&map, &plan.warp)?;
     }
     Ok(Fitted::Rtw { base, warps })
 }
 
-/// The eye samples a directional light travelling along `direction` reaches from
-/// the side the eye sees: normal (facing the eye, as a G-buffer's) with `n . l` at
-/// least `shadowmap_frustum::FRONT_LIT_MIN_COS`, or unknown (zero). The others are
-/// dark whatever the map holds (the quality measure leaves them out too), and a
-/// surface turned away from the light close to the eye would otherwise claim the
-/// densest rows and columns of the warp (twice the uniform fit's error in a room
-/// seen along the light).
-fn front_lit(samples: &[EyeSample], direction: Vec3) -> Vec<EyeSample> {
-    let toward = -direction.normalize_or_zero();
+/// The eye samples `light` reaches from the side the eye sees: normal (facing the
+/// eye, as a G-buffer's) with `n . l` at least `shadowmap_frustum::FRONT_LIT_MIN_COS`
+/// (`l` toward the light: against a directional light's travel, toward a spot's
+/// position), or unknown (zero). The others are dark whatever the map holds (the
+/// quality measure leaves them out too), and a surface turned away from the light
+/// close to the eye would otherwise claim the densest rows and columns of the warp
+/// (twice the uniform fit's error in a room seen along the light).
+fn front_lit(samples: &[EyeSample], light: LightDirection) -> Vec<EyeSample> {
     samples
         .iter()
         .filter(|s| {
-            s.normal
-                .try_normalize()
-                .is_none_or(|n| f64::from(n.dot(toward)) >= FRONT_LIT_MIN_COS)
+            let toward = match light {
+                LightDirection::Directional(d) => -d,
+                LightDirection::Position(p) => p - s.position,
+            };
+            match (s.normal.try_normalize(), toward.try_normalize()) {
+                (Some(n), Some(l)) => f64::from(n.dot(l)) >= FRONT_LIT_MIN_COS,
+                (None, _) => true,
+                (Some(_), None) => false,
+            }
         })
         .copied()
         .collect()
@@ -514,7 +527,13 @@ mod tests {
             sample(Vec3::NEG_Y),               // turned away
             sample(Vec3::ZERO),                // unknown: kept
         ];
-        let kept = front_lit(&samples, down);
+        let kept = front_lit(&samples, LightDirection::Directional(down));
         assert_eq!(kept, vec![samples[0], samples[1], samples[4]]);
+        // A light above at a position: the same samples, seen from it.
+        let above = LightDirection::Position(Vec3::new(0.0, 5.0, 0.0));
+        assert_eq!(front_lit(&samples, above), kept);
+        // A light at a sample's own position lights nothing with a known normal.
+        let at = LightDirection::Position(Vec3::ZERO);
+        assert_eq!(front_lit(&samples, at), vec![samples[4]]);
     }
 }

@@ -1,7 +1,6 @@
-//! The strength of RTW's warp over a directional light's uniform fit, measured at
-//! the eye samples it was built from.
+//! The strength of RTW's warp over its base (a directional light's uniform fit, a
+//! spot light's perspective fit), measured at the eye samples it was built from.
 
-use glam::Vec3;
 use shadowmap_frustum::{Camera, LightDirection, ShadowTransform};
 use shadowmap_rtw::{EyeSample, ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
 
@@ -38,11 +37,10 @@ pub(crate) fn build_measured(
     importance: &ImportanceMap,
     samples: &[EyeSample],
     camera: &Camera,
-    light_direction: Vec3,
+    light: LightDirection,
     options: &WarpOptions,
     warps: &mut WarpMaps,
 ) -> Result<(), FitError> {
-    let light = LightDirection::Directional(light_direction);
     let measure = |mapping: &RtwShadow<'_>| {
         sample_error(
             mapping,
@@ -94,6 +92,7 @@ fn raise(map: &ImportanceMap, t: f32, out: &mut ImportanceMap) -> Result<(), Fit
 mod tests {
     use super::*;
     use alloc::vec::Vec;
+    use glam::Vec3;
     use shadowmap_frustum::{Aabb, Projection, SceneBounds};
     use shadowmap_warp::{UniformOptions, uniform_focused};
 
@@ -164,7 +163,7 @@ mod tests {
             &spike,
             &samples,
             &camera,
-            light,
+            LightDirection::Directional(light),
             &options,
             &mut chosen,
         )
@@ -192,7 +191,7 @@ mod tests {
             &importance,
             &[],
             &camera,
-            light,
+            LightDirection::Directional(light),
             &options,
             &mut chosen,
         )
