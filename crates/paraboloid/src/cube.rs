@@ -127,8 +127,10 @@ pub struct CubeOptions {
     /// Texels over all kept faces (the whole atlas), at least 1. Default `1024²`.
     /// `shadowmap::fit` sets it from its input's budget.
     pub texel_budget: u64,
-    /// How the kept faces share the budget. Default [`FaceSizes::Equal`] (what a
-    /// texture array, and the `shadowmap-wgpu` pass, renders).
+    /// How the kept faces share the budget. Default [`FaceSizes::Equal`] (what
+    /// engines render: a texture array of equal layers). The `shadowmap-wgpu` pass
+    /// renders both, faces sized by need in the corners of layers of the largest
+    /// face's side ([`CubeFace::clip_from_world_in_layer`]).
     pub sizes: FaceSizes,
 }
 
