@@ -19,7 +19,10 @@
 //!
 //! Output in [`Options::out`]: `index.html` (the page to read: every table,
 //! picture and plot below, labelled, with the definitions; self-contained, it opens
-//! from disk), `report.md`, `metrics.csv`, `legend.png` and `colorbar.svg` (the
+//! from disk), `report.md`, `metrics.csv` (the techniques), `references.csv` (the
+//! references of [`TechniqueKind::is_reference`], same columns: the engines' cube
+//! maps, the bar of the focused cube maps, named in a line under each point
+//! configuration's table, not in it), `legend.png` and `colorbar.svg` (the
 //! heatmaps' colour scale), per configuration `aliasing_<config>.svg` (the p95 of
 //! the aliasing error per view-depth slice of every technique, with the
 //! pixel-matched and logarithmic limits, drawn with `plotters`), and per technique
@@ -27,7 +30,7 @@
 //! screen) and `mask_<config>_<technique>.png` (three panels: the technique's
 //! shadow mask, the ray-traced mask, the misclassified pixels, over the pixels the
 //! misclassification counts; the others background grey). With
-//! [`Options::sweep`], the sweep's rows join `metrics.csv` (their `config` is the
+//! [`Options::sweep`], the sweep's rows join the two CSVs (their `config` is the
 //! sweep case, `random_<scene>_<k>`), `report.md` ends with the sweep's wins, ties
 //! and losses per technique and `sweep.svg` plots them; the sweep writes no other
 //! pictures. The images the wgpu backend's `render_scene` example writes into
@@ -42,7 +45,7 @@
 //! of an earlier run. An existing [`Options::out`] that holds anything other than
 //! report files is refused rather than replaced.
 //!
-//! `metrics.csv` is deterministic: fixed row order (configurations, then techniques
+//! The CSVs are deterministic: fixed row order (configurations, then techniques
 //! in [`TechniqueKind::ALL`] order), fixed float formatting (`{:.6e}`), no timings,
 //! no paths; work is spread over threads but merged in that order, so two runs with
 //! the same options write identical bytes.
@@ -74,7 +77,7 @@ use crate::technique::TechniqueKind;
 pub use image::heat_colour;
 pub use runner::run;
 pub use sweep::{SweepSummary, SweepTally, TIE_BAND, WorstCase, baseline_of};
-pub use text::{metrics_csv, summary_table};
+pub use text::{metrics_csv, references_csv, summary_table};
 
 /// What to run.
 #[derive(Clone, Debug, PartialEq)]
@@ -287,6 +290,10 @@ pub struct Report {
     /// One row per configuration and applicable technique, in order; the sweep's
     /// rows follow the configurations' (their `config` is the sweep case).
     pub rows: Vec<Row>,
+    /// The rows of the references ([`TechniqueKind::is_reference`]: the engines'
+    /// cube maps), per configuration and sweep case, in the rows' order; in
+    /// `references.csv`, not among the techniques.
+    pub references: Vec<Row>,
     /// The sweep's cases, in order (empty without a sweep).
     pub sweep_configs: Vec<ConfigSummary>,
     /// Wins, ties and losses of each technique against its baseline over the sweep.

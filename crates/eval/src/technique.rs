@@ -176,6 +176,16 @@ impl TechniqueKind {
         }
     }
 
+    /// Whether the kind is a reference the report measures beside the techniques
+    /// rather than one of them: the engines' cube maps (full faces of one size), the
+    /// bar the library's focused cube maps must meet. Its rows go to
+    /// `references.csv` and the reference lines of the report, not to the technique
+    /// tables, `metrics.csv` or the pictures.
+    #[must_use]
+    pub const fn is_reference(self) -> bool {
+        matches!(self, Self::CubeUnfocused)
+    }
+
     /// Short identifier for tables and file names.
     #[must_use]
     pub const fn name(self) -> &'static str {

@@ -58,12 +58,24 @@ fn quick_runs_are_byte_identical_and_complete() {
         assert!(text.lines().any(|l| l.starts_with(&format!("{},", c.name))));
     }
     for kind in TechniqueKind::ALL {
+        let (rows, references) = if kind.is_reference() {
+            (&ra.references, &ra.rows)
+        } else {
+            (&ra.rows, &ra.references)
+        };
         assert!(
-            ra.rows.iter().any(|r| r.technique == kind),
+            rows.iter().any(|r| r.technique == kind),
             "{} never evaluated",
             kind.name()
         );
+        assert!(references.iter().all(|r| r.technique != kind));
     }
+    // The references have a CSV of their own, in the same columns; the technique
+    // tables do not list them.
+    let references = std::fs::read_to_string(a.join("references.csv")).unwrap();
+    assert_eq!(references.lines().count(), ra.references.len() + 1);
+    assert_eq!(references.lines().next(), text.lines().next());
+    assert!(references.contains(",cube_unfocused,") && !text.contains(",cube_unfocused,"));
     // The overhead configuration: every directional technique measured.
     assert!(
         ra.rows

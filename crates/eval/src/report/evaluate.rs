@@ -97,7 +97,7 @@ pub(super) fn evaluate_config(
         bar.set_message(format!("{}: {}", config.name, kind.name()));
         let outcome = match measure(kind, config, &reference, &setup) {
             Ok(measured) => {
-                if let Some(out) = pictures {
+                if let Some(out) = pictures.filter(|_| !kind.is_reference()) {
                     let base = format!("{}_{}", config.name, kind.name());
                     files.extend(write_pictures(out, &base, &reference, &measured, settings)?);
                     profiles.push(depth_profile(kind, &reference, &measured.m));

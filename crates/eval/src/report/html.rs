@@ -323,6 +323,9 @@ fn config_section(s: &mut String, report: &Report, c: &ConfigSummary) {
     }
     let rows: Vec<&Row> = report.rows.iter().filter(|r| r.config == c.name).collect();
     table(s, &rows, best.map(|b| b.0));
+    for line in super::text::reference_lines(report, &c.name) {
+        let _ = writeln!(s, "<p>{}</p>", esc(&line));
+    }
     let measured: Vec<&Row> = rows.iter().copied().filter(|r| r.outcome.is_ok()).collect();
     pictures(s, c, &measured);
 }

@@ -31,7 +31,13 @@ pub(super) struct Staging {
 pub(super) fn is_report_file(name: &str) -> bool {
     matches!(
         name,
-        "report.md" | "metrics.csv" | "legend.png" | "index.html" | "colorbar.svg" | "sweep.svg"
+        "report.md"
+            | "metrics.csv"
+            | "references.csv"
+            | "legend.png"
+            | "index.html"
+            | "colorbar.svg"
+            | "sweep.svg"
     ) || (name.ends_with(".png") && (name.starts_with("heatmap_") || name.starts_with("mask_")))
         || (name.ends_with(".svg") && name.starts_with("aliasing_"))
 }

@@ -18,8 +18,8 @@ use super::image::{legend_image, write_png};
 use super::output::{Staging, rendered_images};
 use super::plots::{colour_bar_svg, sweep_plot_svg};
 use super::sweep::summarize;
-use super::text::{markdown, metrics_csv};
-use super::{Options, Report, Settings};
+use super::text::{markdown, metrics_csv, references_csv};
+use super::{Options, Report, Row, Settings};
 
 /// Runs the comparison and writes the report into `options.out`.
 ///
@@ -65,25 +65,43 @@ pub fn run(options: &Options) -> Result<Report, EvalError> {
         seed: options.seed,
         configs: Vec::new(),
         rows: Vec::new(),
+        references: Vec::new(),
         files: Vec::new(),
         sweep_configs: Vec::new(),
         sweep: None,
     };
     for out in outputs {
         report.configs.push(out.summary);
-        report.rows.extend(out.rows);
+        report.add_rows(out.rows);
         report.files.extend(out.files);
     }
     for out in sweep_outputs {
         report.sweep_configs.push(out.summary);
-        report.rows.extend(out.rows);
+        report.add_rows(out.rows);
     }
     if options.sweep > 0 {
-        report.sweep = Some(summarize(&report.sweep_configs, &report.rows));
+        report.sweep = Some(summarize(
+            &report.sweep_configs,
+            &report.rows,
+            &report.references,
+        ));
     }
     write_report_files(&mut report, staging.path(), &rendered)?;
     staging.commit()?;
     Ok(report)
+}
+
+impl Report {
+    /// Files `rows` under the techniques or the references.
+    fn add_rows(&mut self, rows: Vec<Row>) {
+        for row in rows {
+            if row.technique.is_reference() {
+                self.references.push(row);
+            } else {
+                self.rows.push(row);
+            }
+        }
+    }
 }
 
 /// The standard configurations, plus the user mesh's.
@@ -306,7 +324,10 @@ fn write_report_files(
     report.files.push(html.clone());
     let csv = PathBuf::from("metrics.csv");
     write_file(&out.join(&csv), &metrics_csv(report))?;
+    let references = PathBuf::from("references.csv");
+    write_file(&out.join(&references), &references_csv(report))?;
     report.files.push(csv);
+    report.files.push(references);
     let md = PathBuf::from("report.md");
     report.files.push(md.clone());
     report.files.sort();

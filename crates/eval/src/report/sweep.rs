@@ -98,7 +98,9 @@ fn p95(row: &Row) -> Option<f64> {
 }
 
 /// Counts every technique of every case in `cases` against its baseline.
-pub(super) fn summarize(cases: &[ConfigSummary], rows: &[Row]) -> SweepSummary {
+/// The baselines are looked up among `rows` and `references` (the engines' cube maps,
+/// the bar of the focused ones).
+pub(super) fn summarize(cases: &[ConfigSummary], rows: &[Row], references: &[Row]) -> SweepSummary {
     let mut tallies: Vec<SweepTally> = Vec::new();
     for case in cases {
         let case_rows: Vec<&Row> = rows.iter().filter(|r| r.config == case.name).collect();
@@ -108,8 +110,10 @@ pub(super) fn summarize(cases: &[ConfigSummary], rows: &[Row]) -> SweepSummary {
             };
             let base = case_rows
                 .iter()
+                .copied()
+                .chain(references.iter().filter(|r| r.config == case.name))
                 .find(|r| r.technique == baseline)
-                .and_then(|r| p95(r));
+                .and_then(p95);
             let tally = match tallies
                 .iter_mut()
                 .position(|t| t.technique == row.technique)

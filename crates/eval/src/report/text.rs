@@ -16,16 +16,27 @@ fn sci(x: Option<f64>) -> String {
     }
 }
 
-/// The CSV of a report (see the module docs for its guarantees).
+/// The CSV of a report's technique rows (see the module docs for its guarantees).
 #[must_use]
 pub fn metrics_csv(report: &Report) -> String {
+    rows_csv(report, &report.rows)
+}
+
+/// The CSV of a report's reference rows ([`TechniqueKind::is_reference`]), in the
+/// columns of [`metrics_csv`].
+#[must_use]
+pub fn references_csv(report: &Report) -> String {
+    rows_csv(report, &report.references)
+}
+
+fn rows_csv(report: &Report, rows: &[Row]) -> String {
     let mut s = String::from(
         "config,technique,status,layers,layer_side,texels,visible_pixels,measured_pixels,\
          m_mean,m_median,m_p95,m_max,m_persp_median,m_persp_p95,m_persp_max,\
          storage_factor,storage_factor_persp,storage_factor_sep_persp,used_texel_fraction,\
          misclassification,phase_jitter,flip_rate,log_bound\n",
     );
-    for row in &report.rows {
+    for row in rows {
         let bound = report
             .configs
             .iter()
@@ -284,6 +295,40 @@ fn markdown_header(report: &Report) -> String {
 }
 
 /// One configuration: its description, its table and its pictures.
+/// The reference rows of configuration `config` in a sentence each: the reference's
+/// p95 `m` and the technique that must meet it, with their ratio.
+pub(super) fn reference_lines(report: &Report, config: &str) -> Vec<String> {
+    let p95 = |row: &Row| row.outcome.as_ref().ok()?.aliasing.m.map(|m| m.p95);
+    report
+        .references
+        .iter()
+        .filter(|r| r.config == config)
+        .map(|reference| {
+            let bar = TechniqueKind::ALL
+                .into_iter()
+                .find(|k| k.baseline() == Some(reference.technique));
+            let held = bar.and_then(|k| {
+                let row = report
+                    .rows
+                    .iter()
+                    .find(|r| r.config == config && r.technique == k)?;
+                Some((k, p95(row)?))
+            });
+            let mut line = format!(
+                "Reference, not a technique: {} (the engines' cube maps, full faces of \
+                 one size), p95 m {}",
+                reference.technique.name(),
+                short(p95(reference))
+            );
+            if let (Some((k, v)), Some(r)) = (held, p95(reference)) {
+                let _ = write!(line, "; {} {} ({:.2}x)", k.name(), short(Some(v)), v / r);
+            }
+            line.push('.');
+            line
+        })
+        .collect()
+}
+
 fn config_section(s: &mut String, report: &Report, c: &ConfigSummary) {
     let _ = writeln!(s, "## {}\n", c.name);
     let _ = writeln!(
@@ -334,6 +379,9 @@ fn config_section(s: &mut String, report: &Report, c: &ConfigSummary) {
         }
     }
     s.push('\n');
+    for line in reference_lines(report, &c.name) {
+        let _ = writeln!(s, "{line}\n");
+    }
     for row in report
         .rows
         .iter()
