@@ -466,15 +466,9 @@ fn front_lit(samples: &[EyeSample], light: LightDirection) -> Vec<EyeSample> {
     samples
         .iter()
         .filter(|s| {
-            let toward = match light {
-                LightDirection::Directional(d) => -d,
-                LightDirection::Position(p) => p - s.position,
-            };
-            match (s.normal.try_normalize(), toward.try_normalize()) {
-                (Some(n), Some(l)) => f64::from(n.dot(l)) >= FRONT_LIT_MIN_COS,
-                (None, _) => true,
-                (Some(_), None) => false,
-            }
+            s.normal.try_normalize().is_none_or(|n| {
+                n.as_dvec3().dot(light.toward(s.position.as_dvec3())) >= FRONT_LIT_MIN_COS
+            })
         })
         .copied()
         .collect()

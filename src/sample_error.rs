@@ -59,11 +59,7 @@ impl Probe {
     ) -> Option<f64> {
         let p = s.position.as_dvec3();
         let to_eye = -self.steps.ray(p)?;
-        let to_light = match self.light {
-            LightDirection::Directional(d) => -d.as_dvec3(),
-            LightDirection::Position(at) => at.as_dvec3() - p,
-        }
-        .normalize_or_zero();
+        let to_light = self.light.toward(p);
         let n = s.normal.as_dvec3().normalize_or_zero();
         let n = if n.dot(to_light) >= FRONT_LIT_MIN_COS {
             n

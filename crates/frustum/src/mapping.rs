@@ -55,6 +55,20 @@ pub enum LightDirection {
     Position(Vec3),
 }
 
+impl LightDirection {
+    /// The unit vector from `world` toward the light: against a directional light's
+    /// travel, toward a positional light's position; zero at that position (or for
+    /// a zero direction).
+    #[must_use]
+    pub fn toward(self, world: DVec3) -> DVec3 {
+        match self {
+            Self::Directional(d) => -d.as_dvec3(),
+            Self::Position(at) => at.as_dvec3() - world,
+        }
+        .normalize_or_zero()
+    }
+}
+
 /// The matrices of a matrix-based shadow technique (uniform, one cascade, spot,
 /// LiSPSM, XPSM, TSM).
 ///
