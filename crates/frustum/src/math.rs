@@ -186,7 +186,12 @@ mod tests {
         #[test]
         fn round_matches_std(bits in any::<u64>(), scale in -60i32..60) {
             let x = f64::from_bits(bits);
-            prop_assert_eq!(super::round(x).to_bits(), x.round().to_bits());
+            if x.is_nan() {
+                // A NaN stays a NaN (std may quiet a signalling one: other bits).
+                prop_assert!(super::round(x).is_nan());
+            } else {
+                prop_assert_eq!(super::round(x).to_bits(), x.round().to_bits());
+            }
             // Values near the scale of texel snapping, halves included.
             let y = (bits >> 11) as f64 * 2f64.powi(scale - 53);
             for v in [y, -y, y.floor() + 0.5, -(y.floor() + 0.5)] {
