@@ -45,12 +45,17 @@ const COLUMNS: usize = 8;
 const ROWS: usize = 6;
 /// Probe points per ray.
 const DEPTHS: usize = 4;
+// `ray_points` spaces them by the eighth root of the depth ratio (three square roots).
+const _: () = assert!(DEPTHS == 4);
 /// Exponent of the power mean over the probe points (between a mean and a maximum,
 /// close to the high percentiles by which the quality report ranks techniques).
-const POWER: f64 = 8.0;
+const POWER: i32 = 8;
+// `Probe::error` raises `1 / s²` to the fourth power.
+const _: () = assert!(POWER == 8);
 /// Smallest weight of a ray that meets the box.
 const RAY_WEIGHT_FLOOR: f64 = 1e-3;
-/// Relative screen step of the pixel Jacobian.
+/// Screen step (a fraction of the screen height) of the probe points' Jacobians:
+/// a unit common to every candidate, so its size only scales the error.
 const STEP: f64 = 1e-3;
 
 /// One probe point: the world point, the world displacements of one screen step in
@@ -63,12 +68,15 @@ struct Point {
     weight: f64,
 }
 
-/// A neighbouring pixel's ray (see [`Screen::neighbours`]).
+/// The ray through one screen position and how it moves with the screen: its
+/// origin on the near face, its direction (to the far face), and their derivatives
+/// per unit of normalized screen `x` and `y`.
 #[derive(Clone, Copy)]
-struct Neighbour {
+struct Ray {
     origin: DVec3,
     dir: DVec3,
-    length: f64,
+    d_origin: [DVec3; 2],
+    d_dir: [DVec3; 2],
 }
 
 /// The probe points of a focus body.
@@ -87,44 +95,23 @@ struct Screen {
     eye: DVec3,
 }
 
-/// The points at horizontal position `x` on the bottom and top edges of the near and
-/// far faces: the ray through `(x, y)` runs between their interpolations at `y`
-/// ([`Screen::ray_between`]).
-#[derive(Clone, Copy)]
-struct Edges {
-    near: (DVec3, DVec3),
-    far: (DVec3, DVec3),
-}
-
 impl Screen {
-    fn edges(&self, x: f64) -> Edges {
-        let edge = |q: &[DVec3; 4]| (q[0].lerp(q[1], x), q[3].lerp(q[2], x));
-        Edges {
-            near: edge(&self.near),
-            far: edge(&self.far),
-        }
-    }
-
-    /// The ray at height `y` between the edges.
-    fn ray_between(&self, e: &Edges, y: f64) -> (DVec3, DVec3) {
-        let origin = e.near.0.lerp(e.near.1, y);
-        (origin, e.far.0.lerp(e.far.1, y) - origin)
-    }
-
-    /// The rays through `at` moved one step in `+x`, `-x`, `+y` and `-y` (`edges`
-    /// are those of `at.x`), each with its length.
-    fn neighbours(&self, at: DVec2, step: DVec2, edges: &Edges) -> [Neighbour; 4] {
-        let ray = |(origin, dir): (DVec3, DVec3)| Neighbour {
-            origin,
-            dir,
-            length: dir.length(),
+    /// The ray through `(x, y)`: the bilinear interpolation of the near and of the
+    /// far face's corners, and its exact derivatives in `x` and `y`.
+    fn ray(&self, x: f64, y: f64) -> Ray {
+        let at = |q: &[DVec3; 4]| {
+            let (bottom, top) = (q[0].lerp(q[1], x), q[3].lerp(q[2], x));
+            let along_x = (q[1] - q[0]).lerp(q[2] - q[3], y);
+            (bottom.lerp(top, y), [along_x, top - bottom])
         };
-        [
-            ray(self.ray_between(&self.edges(at.x + step.x), at.y)),
-            ray(self.ray_between(&self.edges(at.x - step.x), at.y)),
-            ray(self.ray_between(edges, at.y + step.y)),
-            ray(self.ray_between(edges, at.y - step.y)),
-        ]
+        let (origin, d_origin) = at(&self.near);
+        let (far, d_far) = at(&self.far);
+        Ray {
+            origin,
+            dir: far - origin,
+            d_origin,
+            d_dir: [d_far[0] - d_origin[0], d_far[1] - d_origin[1]],
+        }
     }
 
     fn depth(&self, p: DVec3) -> f64 {
@@ -187,15 +174,15 @@ impl Probe {
                 let dh = cx * d.x + cy * d.y + cz * d.z;
                 (DVec2::new(dh.x, dh.y) * hw - DVec2::new(h.x, h.y) * dh.z) / (hw * hw)
             };
-            let s = math::smaller_singular_value(ndc(q.dx), ndc(q.dy));
-            if !(s > 0.0) {
+            let inv_s2 = inverse_square_smaller_singular_value(ndc(q.dx), ndc(q.dy));
+            if !(inv_s2 < f64::INFINITY) {
                 return f64::INFINITY;
             }
-            sum += q.weight * pow8(1.0 / s);
+            sum += q.weight * pow4(inv_s2);
             weights += q.weight;
         }
         if weights > 0.0 {
-            math::powf(sum / weights, 1.0 / POWER)
+            math::powf(sum / weights, 1.0 / f64::from(POWER))
         } else {
             0.0
         }
@@ -233,8 +220,8 @@ fn ray_points(
     light: DVec3,
     out: &mut ArrayVec<Point, { COLUMNS * ROWS * DEPTHS }>,
 ) -> f64 {
-    let edges = screen.edges(at.x);
-    let (o, d) = screen.ray_between(&edges, at.y);
+    let ray = screen.ray(at.x, at.y);
+    let (o, d) = (ray.origin, ray.dir);
     let (mut enter, mut exit) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
     for axis in 0..3 {
         if d[axis] == 0.0 {
@@ -267,21 +254,13 @@ fn ray_points(
         0.0
     };
     let beta = if s_exit < 1.0 { log_step(zf / z1) } else { 0.0 };
-    // The neighbouring pixels' rays, computed once for every point of this ray.
-    let mut near_rays = None;
-    let mut point = |p: DVec3, n: DVec3, weight: f64| {
-        if !(weight > 0.0) {
-            return None;
-        }
-        let rays = near_rays.get_or_insert_with(|| screen.neighbours(at, step, &edges));
-        point_at(rays, p, n, weight)
-    };
-    let mut probe = |s: f64, n: DVec3, weight: f64| {
+    let point = |s: f64, n: DVec3, weight: f64| point_at(&ray, step, s, n, weight);
+    let probe = |s: f64, n: DVec3, weight: f64| {
         // Only front-lit surfaces matter: within about 3° of parallel to the light
         // shading darkens a surface whatever the map says (and its texels stretch
         // without bound), so such faces fade out between sin 3° and sin 6°.
         let lit = smoothstep(0.05, 0.1, -n.dot(light));
-        point(o + d * s, n, weight * lit)
+        point(s, n, weight * lit)
     };
     let face = |s_face: f64, slabs: &[f64; 3]| {
         let mut n = DVec3::ZERO;
@@ -326,10 +305,12 @@ fn ray_points(
         return ray_weight;
     }
     let n = bisector / facing;
-    let ln_ratio = math::ln(z1 / z0);
-    for k in 0..DEPTHS {
-        let z = z0 * math::exp(ln_ratio * (k as f64 + 0.5) / DEPTHS as f64);
-        push(point(o + d * ((z - zn) / (zf - zn)), n, w_volume));
+    // Depths `z0 (z1 / z0)^((k + 1/2) / DEPTHS)`: odd powers of the eighth root.
+    let root = math::sqrt(math::sqrt(math::sqrt(z1 / z0)));
+    let mut z = z0 * root;
+    for _ in 0..DEPTHS {
+        push(point((z - zn) / (zf - zn), n, w_volume));
+        z *= root * root;
     }
     ray_weight
 }
@@ -350,31 +331,51 @@ fn log_step(x: f64) -> f64 {
     }
 }
 
-/// The probe point at `p`, on the plane through `p` with normal `n`: its screen
-/// steps are where the neighbouring pixels' rays ([`Screen::neighbours`]) meet that
-/// plane.
-fn point_at(rays: &[Neighbour; 4], p: DVec3, n: DVec3, weight: f64) -> Option<Point> {
-    let on_plane = |r: &Neighbour| -> Option<DVec3> {
-        let (ro, rd) = (r.origin, r.dir);
-        let denom = n.dot(rd);
-        (denom.abs() > 1e-12 * r.length).then(|| ro + rd * (n.dot(p - ro) / denom))
+/// The probe point at parameter `s` of `ray`, on the plane through it with normal
+/// `n`: its screen steps are how far the point moves on that plane when the ray
+/// moves by `step` on the screen.
+///
+/// With `p(u) = o(u) + d(u) t(u)` the hit of the plane, `t` its ray parameter, the
+/// derivative in a screen coordinate `u` is `P (o' + d' t)`, `P = I - d nᵀ / (n·d)`
+/// the projection along the ray onto the plane: what the neighbouring pixels'
+/// rays meet the plane at, in the limit of a small step.
+fn point_at(ray: &Ray, step: DVec2, s: f64, n: DVec3, weight: f64) -> Option<Point> {
+    if !(weight > 0.0) {
+        return None;
+    }
+    let d = ray.dir;
+    let denom = n.dot(d);
+    if !(denom.abs() > 1e-12 * d.length()) {
+        return None;
+    }
+    let moved = |axis: usize, h: f64| {
+        let v = (ray.d_origin[axis] + ray.d_dir[axis] * s) * h;
+        v - d * (n.dot(v) / denom)
     };
-    let (xp, xm) = (on_plane(&rays[0])?, on_plane(&rays[1])?);
-    let (yp, ym) = (on_plane(&rays[2])?, on_plane(&rays[3])?);
     let q = Point {
-        p,
-        dx: (xp - xm) * 0.5,
-        dy: (yp - ym) * 0.5,
+        p: ray.origin + d * s,
+        dx: moved(0, step.x),
+        dy: moved(1, step.y),
         weight,
     };
-    (weight > 0.0 && p.is_finite() && q.dx.is_finite() && q.dy.is_finite()).then_some(q)
+    (q.p.is_finite() && q.dx.is_finite() && q.dy.is_finite()).then_some(q)
 }
 
-/// `x^8`.
-fn pow8(x: f64) -> f64 {
+/// `x^4` (`m^P` from `1 / s²`, `P = 8`).
+fn pow4(x: f64) -> f64 {
     let x2 = x * x;
-    let x4 = x2 * x2;
-    x4 * x4
+    x2 * x2
+}
+
+/// `1 / s²`, `s` the smaller singular value of the 2x2 matrix with columns `a` and
+/// `b` (as [`math::smaller_singular_value`], without its square roots but the
+/// discriminant's): infinite or NaN where `s` is 0 or undefined.
+fn inverse_square_smaller_singular_value(a: DVec2, b: DVec2) -> f64 {
+    let frobenius = a.length_squared() + b.length_squared();
+    let det = a.perp_dot(b);
+    let root = math::sqrt((frobenius * frobenius - 4.0 * det * det).max(0.0));
+    let inv = (frobenius + root) / (2.0 * det * det);
+    if inv > 0.0 { inv } else { f64::INFINITY }
 }
 
 /// Strengths at which a warp is evaluated, as fractions of its formula's warp in
