@@ -97,6 +97,10 @@ pub struct Options {
     pub sweep: usize,
     /// Worker threads (at least 1).
     pub threads: usize,
+    /// Only the configurations (standard and sweep) whose name contains one of
+    /// these strings; every configuration when empty. To re-measure a sweep's
+    /// worst case alone: `compare --sweep 64 --only random_city_block_006`.
+    pub only: Vec<String>,
     /// Show a progress bar on stderr (for a terminal): the current configuration
     /// and technique, and an estimate of the time left.
     pub progress: bool,
@@ -114,6 +118,7 @@ impl Default for Options {
             mesh: None,
             sweep: 0,
             threads: 2,
+            only: Vec::new(),
             progress: false,
             progress_lines: false,
         }
@@ -149,6 +154,12 @@ impl Options {
     #[must_use]
     pub const fn with_threads(mut self, threads: usize) -> Self {
         self.threads = threads;
+        self
+    }
+    /// Only the configurations whose name contains one of `names` (all when empty).
+    #[must_use]
+    pub fn with_only(mut self, names: Vec<String>) -> Self {
+        self.only = names;
         self
     }
     /// With a robustness sweep of `cases` random configurations per scene.

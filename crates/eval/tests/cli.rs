@@ -208,6 +208,47 @@ fn rerun_replaces_the_report_without_stale_files() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+#[test]
+fn only_measures_the_configurations_named() {
+    let dir = scratch("only");
+    let target = dir.join("out");
+    let out = compare(&[
+        "--quick",
+        "--only",
+        "top_down",
+        "--only",
+        "facing_spot",
+        "--out",
+        s(&target),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let csv = std::fs::read_to_string(target.join("metrics.csv")).unwrap();
+    let mut configs: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').next())
+        .collect();
+    configs.dedup();
+    assert_eq!(configs, ["facing_spot", "top_down"]);
+    // A name that matches nothing is a usage error, before anything is written.
+    let none = dir.join("none");
+    let out = compare(&[
+        "--quick",
+        "--only",
+        "no_such_configuration",
+        "--out",
+        s(&none),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr(&out).contains("no_such_configuration"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!none.exists(), "nothing written");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 // ------------------------------------------------------------- mesh input
 
 fn mesh_error(tag: &str, file: &str, bytes: &[u8]) -> (PathBuf, String) {

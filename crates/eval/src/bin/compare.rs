@@ -1,7 +1,7 @@
 //! `compare`: every shadow-map technique on every evaluation configuration.
 //!
 //! ```text
-//! cargo run --release -p shadowmap-eval --bin compare -- [--out DIR] [--quick] [--seed N] [--mesh PATH] [--sweep N] [--threads N]
+//! cargo run --release -p shadowmap-eval --bin compare -- [--out DIR] [--quick] [--seed N] [--mesh PATH] [--sweep N] [--only NAME] [--threads N]
 //! ```
 //!
 //! Prints what `m`, `p95` and `S` mean, a summary table (median, p95 and max
@@ -51,6 +51,11 @@ struct Args {
     /// every technique against its baseline (0: none).
     #[arg(long, default_value_t = 0)]
     sweep: usize,
+    /// Only the configurations (standard and sweep) whose name contains NAME
+    /// (repeat for several), e.g. a sweep's worst case:
+    /// `--sweep 64 --only random_city_block_006`.
+    #[arg(long, value_name = "NAME")]
+    only: Vec<String>,
     /// Worker threads (at least 1).
     #[arg(long, default_value_t = 2, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     threads: usize,
@@ -65,6 +70,7 @@ fn main() -> ExitCode {
         .with_mesh(args.mesh)
         .with_threads(args.threads)
         .with_sweep(args.sweep)
+        .with_only(args.only)
         .with_progress(std::io::stderr().is_terminal())
         .with_progress_lines(!std::io::stderr().is_terminal());
     match report::run(&options) {

@@ -45,11 +45,20 @@ pub fn run(options: &Options) -> Result<Report, EvalError> {
     // Every input is checked before the first configuration is evaluated.
     let configs = configurations(options, &settings)?;
     let sweep_settings = Settings::sweep();
-    let sweep_configs = if options.sweep > 0 {
+    let mut sweep_configs = if options.sweep > 0 {
         sweep_configurations(&config_options(options, &sweep_settings), options.sweep)?
     } else {
         Vec::new()
     };
+    sweep_configs.retain(|c| options.selects(&c.name));
+    if configs.is_empty() && sweep_configs.is_empty() {
+        return Err(EvalError::InvalidOption {
+            message: format!(
+                "--only {:?}: no configuration has such a name",
+                options.only
+            ),
+        });
+    }
     let staging = Staging::create(&options.out)?;
     let outputs = evaluate_all(&configs, &settings, options, staging.path(), true)?;
     let sweep_outputs = evaluate_all(
@@ -111,7 +120,15 @@ fn configurations(options: &Options, settings: &Settings) -> Result<Vec<Configur
     if let Some(path) = &options.mesh {
         configs.push(user_mesh_configuration(path, &config_options)?);
     }
+    configs.retain(|c| options.selects(&c.name));
     Ok(configs)
+}
+
+impl Options {
+    /// Whether the configuration `name` is measured ([`Options::only`]).
+    fn selects(&self, name: &str) -> bool {
+        self.only.is_empty() || self.only.iter().any(|part| name.contains(part.as_str()))
+    }
 }
 
 /// The configuration of a user mesh; every error names the file.
