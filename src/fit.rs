@@ -357,19 +357,28 @@ pub(crate) fn predicted_percentiles(
     out: &mut [Option<f64>],
 ) -> Result<(), FitError> {
     let mut predicted = [None::<PredictedError>; MAX_PREDICT_CANDIDATES];
-    let predicted = predicted
-        .get_mut(..mappings.len())
-        .ok_or(FitError::NoCandidate)?;
+    predictions(input, mappings, &mut predicted)?;
+    for (slot, p) in out.iter_mut().zip(predicted.iter()) {
+        *slot = p.map(|p| p.percentile);
+    }
+    Ok(())
+}
+
+/// The predicted errors of `mappings` for a frame, all on the same rays, into the
+/// first `mappings.len()` slots of `out`.
+pub(crate) fn predictions(
+    input: &FitInput<'_>,
+    mappings: &[(&dyn ShadowMapping, u32)],
+    out: &mut [Option<PredictedError>; MAX_PREDICT_CANDIDATES],
+) -> Result<(), FitError> {
+    let out = out.get_mut(..mappings.len()).ok_or(FitError::NoCandidate)?;
     predict_errors(
         input.camera,
         &input.scene.receivers,
         mappings,
         &predict_options(input),
-        predicted,
+        out,
     )?;
-    for (slot, p) in out.iter_mut().zip(predicted.iter()) {
-        *slot = p.map(|p| p.percentile);
-    }
     Ok(())
 }
 
