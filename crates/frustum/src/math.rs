@@ -43,6 +43,10 @@ unary! {
     ln => log;
     /// `e^x`.
     exp => exp;
+    /// `ln(1 + x)`, accurate for small `x`.
+    ln_1p => log1p;
+    /// `e^x - 1`, accurate for small `x`.
+    exp_m1 => expm1;
     /// Largest integer not above `x`.
     floor => floor;
     /// Smallest integer not below `x`.

@@ -156,8 +156,9 @@ type Hom = DVec4;
 ///    (in the near-parallel band the frame turns continuously toward the camera's
 ///    up vector). Miner's lamp: the paper switches to orthographic focusing at
 ///    `|V_xy| < 0.1`; here the projection vector fades out between `2 t` and `t`
-///    ([`XpsmOptions::miner_lamp_threshold`]), ending in the same orthographic fit
-///    with focusing, so nothing pops.
+///    ([`XpsmOptions::miner_lamp_threshold`]; the warp ratio `1 + lengthP D` is
+///    raised to a smoothstep weight, as LiSPSM and TSM fade), ending in the same
+///    orthographic fit with focusing, so nothing pops.
 /// 4. `minCastersProj`, `minReceiversProj`: smallest projections on `unit P`.
 /// 5. `maxLengthP = (epsilonW - 1) / max(minCastersProj, minReceiversProj)` when the
 ///    focus interval starts behind the viewer (no bound otherwise).
@@ -250,7 +251,10 @@ fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow
     let weight = smoothstep(thr, 2.0 * thr, v_xy);
     // Step 6 (first, since the automatic length places the origin): optimal length.
     let (length_p, shift) = match options.coef {
-        Some(c) if weight > 0.0 => (weight * f64::from(c) / v_xy, 0.0),
+        Some(c) if weight > 0.0 => {
+            let (y0, y1) = f.warp_axis_range();
+            (faded_length(f64::from(c) / v_xy, y1 - y0, weight), 0.0)
+        }
         Some(_) => (0.0, 0.0),
         None => {
             let (length, shift) = auto_length(f, view, weight);
@@ -504,7 +508,22 @@ fn xpsm_fit(
     })
 }
 
-/// The automatic `lengthP`, faded by `weight`.
+/// `lengthP` for the full length `full` over an extent `d` along `unit P`, faded
+/// by `weight` in `[0, 1]` as LiSPSM and TSM fade: the warp ratio `1 + lengthP d`
+/// is raised to the power `weight` (its logarithm scaled), so the fit goes to the
+/// orthographic one as smoothly as the weight. (Scaling `lengthP` itself keeps
+/// most of a strong warp until the weight is nearly 0: a warp ratio of 50 at weight
+/// 0.075 stays 4.7, not 1.34, and a sweep case with a low sun 6.7° off the view
+/// lost 1.29x to the uniform fit on it.)
+fn faded_length(full: f64, d: f64, weight: f64) -> f64 {
+    if weight >= 1.0 || !(d > 0.0) {
+        return full * weight.min(1.0);
+    }
+    let s = math::exp_m1(weight * math::ln_1p(full * d)) / d;
+    if s.is_finite() && s > 0.0 { s } else { 0.0 }
+}
+
+/// The automatic `lengthP`, faded by `weight` ([`faded_length`]).
 ///
 /// The paper warps by `w = 1 + coef d` at view distance `d`, `coef = 1 / sqrt(z_n z_f)`
 /// over the visible receivers, so the warp ratio across the visible depth range is
@@ -540,7 +559,7 @@ fn auto_length(f: &Focus, view: &View, weight: f64) -> (f64, f64) {
     let z_n = z_n.max(1e-6 * z_scale);
     let z_f = z_f.max(z_n);
     let coef = 1.0 / crate::focus::sqrt0(z_n * z_f);
-    let s = weight * coef * (z_f - z_n) / (r1 - r0);
+    let s = faded_length(coef * (z_f - z_n) / (r1 - r0), r1 - r0, weight);
     if !(s.is_finite() && s > 0.0) {
         return (0.0, 0.0);
     }
@@ -692,5 +711,25 @@ mod tests {
             let r = xpsm(&cam, Vec3::NEG_Y, &SceneBounds::whole(receivers), &bad);
             assert_eq!(r.err(), Some(WarpError::InvalidOption));
         }
+    }
+
+    /// In the miner's-lamp band the warp ratio `1 + lengthP D` is the full ratio
+    /// raised to the weight: a ratio of 50 is 7.07 at half weight and 1.34 at
+    /// 0.075 (where scaling `lengthP` kept 4.7), and it grows with the weight.
+    #[test]
+    fn the_warp_ratio_fades_as_a_power_of_the_weight() {
+        let (d, full) = (100.0, 0.49);
+        let ratio = |w: f64| 1.0 + faded_length(full, d, w) * d;
+        assert_eq!(faded_length(full, d, 0.0), 0.0);
+        assert_eq!(faded_length(full, d, 1.0), full);
+        assert!((ratio(0.5) - 50f64.sqrt()).abs() < 1e-9);
+        assert!((ratio(0.075) - 50f64.powf(0.075)).abs() < 1e-9);
+        let mut last = 1.0;
+        for i in 1..=100 {
+            let r = ratio(f64::from(i) / 100.0);
+            assert!(r > last, "ratio {r} at weight {i}/100 after {last}");
+            last = r;
+        }
+        assert!((last - 50.0).abs() < 1e-9);
     }
 }
