@@ -443,3 +443,59 @@ fn parabola_min(e: &[f64; GRID]) -> f64 {
     };
     x.clamp((j - 1) as f64, (j + 1) as f64)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Where the ray through screen position `(x, y)` meets the plane through `p`
+    /// with normal `n`.
+    fn hit(screen: &Screen, x: f64, y: f64, p: DVec3, n: DVec3) -> DVec3 {
+        let r = screen.ray(x, y);
+        r.origin + r.dir * (n.dot(p - r.origin) / n.dot(r.dir))
+    }
+
+    /// The closed-form screen steps equal the central differences of the
+    /// neighbouring rays' hits on the probe plane, to the difference's own error.
+    #[test]
+    fn screen_steps_are_the_derivative_of_the_plane_hits() {
+        // A skewed frustum: no face is a rectangle, so the rays are bilinear.
+        let screen = Screen {
+            near: [
+                DVec3::new(-1.0, -0.5, -1.0),
+                DVec3::new(1.2, -0.6, -1.1),
+                DVec3::new(0.9, 0.7, -0.9),
+                DVec3::new(-1.1, 0.4, -1.0),
+            ],
+            far: [
+                DVec3::new(-60.0, -35.0, -100.0),
+                DVec3::new(70.0, -30.0, -95.0),
+                DVec3::new(55.0, 40.0, -105.0),
+                DVec3::new(-65.0, 30.0, -100.0),
+            ],
+            forward: DVec3::NEG_Z,
+            eye: DVec3::ZERO,
+        };
+        let step = DVec2::new(1e-3, 1e-3);
+        for (x, y, s, n) in [
+            (0.3, 0.2, 0.4, DVec3::Y),
+            (0.8, 0.6, 0.1, DVec3::new(0.3, 0.2, 0.93).normalize()),
+            (0.5, 0.9, 0.75, DVec3::new(-0.7, 0.1, 0.7).normalize()),
+        ] {
+            let ray = screen.ray(x, y);
+            let q = point_at(&ray, step, s, n, 1.0).unwrap();
+            assert!(q.p.distance(ray.origin + ray.dir * s) < 1e-12);
+            let h = 1e-4;
+            let dx = (hit(&screen, x + h, y, q.p, n) - hit(&screen, x - h, y, q.p, n)) / (2.0 * h);
+            let dy = (hit(&screen, x, y + h, q.p, n) - hit(&screen, x, y - h, q.p, n)) / (2.0 * h);
+            for (closed, differenced) in [(q.dx, dx * step.x), (q.dy, dy * step.y)] {
+                let error = (closed - differenced).length() / closed.length();
+                assert!(error < 1e-6, "{closed} vs {differenced}: {error}");
+                assert!(
+                    closed.dot(n).abs() < 1e-9 * closed.length(),
+                    "off the plane"
+                );
+            }
+        }
+    }
+}
