@@ -29,7 +29,7 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
-use crate::{Aabb, Camera, FrustumError, ShadowMapping, math};
+use crate::{Aabb, Camera, FrustumError, LightDirection, ShadowMapping, math};
 
 /// Most rays [`predict_error`] casts (`grid_columns * grid_rows` at most this).
 pub const MAX_PREDICT_RAYS: usize = 1024;
@@ -55,6 +55,11 @@ pub struct PredictOptions {
     /// them would rank techniques by surfaces nobody sees shadowed. When no ray
     /// meets a front-lit face, every ray counts. Default `None` (every ray).
     pub light_direction: Option<Vec3>,
+    /// The position of a spot or point light, if known: as
+    /// [`light_direction`](Self::light_direction), with `l` toward the position
+    /// from the point the ray meets. Takes precedence over `light_direction`.
+    /// Default `None`.
+    pub light_position: Option<Vec3>,
     /// View depths `(near, far)` of the visible surfaces, if known (a depth
     /// reduction, see `DepthBounds`). Each ray's point is kept inside this range:
     /// a face met nearer than `near` or farther than `far` is not what the pixel
@@ -86,6 +91,7 @@ impl PredictOptions {
             grid_rows: 9,
             percentile: 0.95,
             light_direction: None,
+            light_position: None,
             depth_range: None,
         }
     }
@@ -104,6 +110,13 @@ impl PredictOptions {
     #[must_use]
     pub fn with_light_direction(mut self, direction: Vec3) -> Self {
         self.light_direction = direction.try_normalize();
+        self
+    }
+
+    /// Sets [`light_position`](Self::light_position) (a non-finite position: none).
+    #[must_use]
+    pub fn with_light_position(mut self, position: Vec3) -> Self {
+        self.light_position = position.is_finite().then_some(position);
         self
     }
 
@@ -137,6 +150,7 @@ impl PredictOptions {
             && self.percentile > 0.0
             && self.percentile <= 1.0
             && self.light_direction.is_none_or(Vec3::is_finite)
+            && self.light_position.is_none_or(Vec3::is_finite)
             && self
                 .depth_range
                 .is_none_or(|(n, f)| n.is_finite() && f.is_finite() && n > 0.0 && f > n);
@@ -215,17 +229,18 @@ pub fn predict_errors(
     if !(receivers.is_finite() && receivers.is_valid()) {
         return Err(FrustumError::EmptyBounds);
     }
-    let toward_light = options
-        .light_direction
-        .and_then(Vec3::try_normalize)
-        .map(|d| -d.as_dvec3());
+    let light = match (options.light_position, options.light_direction) {
+        (Some(position), _) => Some(LightDirection::Position(position)),
+        (None, Some(direction)) => direction.try_normalize().map(LightDirection::Directional),
+        (None, None) => None,
+    };
     let screen =
         Screen::new(camera, options.viewport_height)?.with_depth_range(options.depth_range);
     let mut errors = [[0.0f64; MAX_PREDICT_RAYS]; MAX_PREDICT_CANDIDATES];
     let mut counts = [0usize; MAX_PREDICT_CANDIDATES];
     // Front-lit shared rays first (without a light: every shared ray, twice); then
     // every shared ray; then each candidate's own rays.
-    let passes = [(toward_light, true), (None, true), (None, false)];
+    let passes = [(light, true), (None, true), (None, false)];
     for (lit_by, shared) in passes {
         counts = [0; MAX_PREDICT_CANDIDATES];
         let pass = Pass {
@@ -251,8 +266,8 @@ struct Pass<'a> {
     screen: &'a Screen,
     receivers: &'a Aabb,
     grid: (u32, u32),
-    /// Only rays meeting a face lit from this direction (toward the light).
-    lit_by: Option<DVec3>,
+    /// Only rays meeting a face this light lights from the front.
+    lit_by: Option<LightDirection>,
     /// Only rays every candidate covers.
     shared: bool,
 }
@@ -277,7 +292,7 @@ impl Pass<'_> {
                 };
                 if self
                     .lit_by
-                    .is_some_and(|l| hit.normal().dot(l) < FRONT_LIT_MIN_COS)
+                    .is_some_and(|l| hit.normal().dot(l.toward(hit.point())) < FRONT_LIT_MIN_COS)
                 {
                     continue;
                 }
@@ -320,6 +335,14 @@ impl Hit {
     fn normal(&self) -> DVec3 {
         match self {
             Self::Face(_, n) | Self::Range(_, n) => *n,
+        }
+    }
+
+    /// The point met (the nearest, for a range).
+    fn point(&self) -> DVec3 {
+        match self {
+            Self::Face(p, _) => *p,
+            Self::Range(points, _) => points[0],
         }
     }
 

@@ -79,6 +79,7 @@ struct PredictOptionsDef {
     grid_rows: u32,
     percentile: f64,
     light_direction: Option<Vec3>,
+    light_position: Option<Vec3>,
     depth_range: Option<(f32, f32)>,
 }
 

@@ -168,6 +168,7 @@ fn predictions_round_trip() {
     let options = PredictOptions::new().with_grid(8, 4).with_percentile(0.9);
     round_trip(&options);
     round_trip(&options.with_light_direction(Vec3::new(0.3, -1.0, 0.2)));
+    round_trip(&options.with_light_position(Vec3::new(3.0, 10.0, -2.0)));
     let predicted = predict_error(
         &camera,
         &receivers,

@@ -61,6 +61,45 @@ fn faces_the_light_does_not_face_are_left_out() {
 }
 
 #[test]
+fn a_positional_light_lights_the_faces_that_face_it() {
+    let map = overhead(400.0);
+    let predict = |options: PredictOptions| {
+        predict_error(&camera(), &ground(), &map, 1024, &options)
+            .unwrap()
+            .unwrap()
+    };
+    // Far above the box a light position acts as a light straight down, far below
+    // as one straight up.
+    let down = predict(PredictOptions::default().with_light_direction(Vec3::NEG_Y));
+    let high = Vec3::new(0.0, 1.0e6, -100.0);
+    assert_eq!(
+        predict(PredictOptions::default().with_light_position(high)),
+        down
+    );
+    let up = predict(PredictOptions::default().with_light_direction(Vec3::Y));
+    let low = Vec3::new(0.0, -1.0e6, -100.0);
+    assert_eq!(
+        predict(PredictOptions::default().with_light_position(low)),
+        up
+    );
+    // The position wins over a direction.
+    let both = PredictOptions::default()
+        .with_light_direction(Vec3::Y)
+        .with_light_position(high);
+    assert_eq!(predict(both), down);
+    // Between the floor and the ceiling it lights both (and the far wall).
+    let inside =
+        predict(PredictOptions::default().with_light_position(Vec3::new(0.0, 20.0, -100.0)));
+    assert!(
+        inside.rays > down.rays && inside.rays > up.rays,
+        "{inside:?}"
+    );
+    // A non-finite position is none.
+    let nan = PredictOptions::default().with_light_position(Vec3::NAN);
+    assert_eq!(nan.light_position, None);
+}
+
+#[test]
 fn a_finer_map_predicts_a_proportionally_smaller_error() {
     let (c, g, map) = (camera(), ground(), overhead(250.0));
     let o = PredictOptions::default();
