@@ -90,26 +90,6 @@ impl ConvexBody {
         Ok(body)
     }
 
-    /// `planes ∩ aabb` for any six planes bounding a convex region; `corners` set the
-    /// rounding scale.
-    pub(crate) fn from_planes_aabb(
-        fplanes: &[DPlane; 6],
-        corners: &[Vec3; 8],
-        aabb: &Aabb,
-    ) -> Result<Self, FrustumError> {
-        let aabb = aabb.validate()?;
-        let scale = corners
-            .iter()
-            .chain(&aabb.corners())
-            .map(|c| c.abs().max_element())
-            .fold(0.0f32, f32::max)
-            .max(f32::MIN_POSITIVE);
-        let mut planes = ArrayVec::new();
-        planes.extend(fplanes.iter().copied());
-        planes.extend(aabb.planes().iter().map(DPlane::from_plane));
-        Ok(Self::from_planes(planes, f64::from(scale)))
-    }
-
     /// The vertices of the region bounded by `planes`: every triple intersection that
     /// lies inside all of them.
     fn from_planes(planes: ArrayVec<DPlane, MAX_BODY_PLANES>, scale: f64) -> Self {

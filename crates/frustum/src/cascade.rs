@@ -6,6 +6,7 @@ use crate::bounding_sphere::{bounding_sphere, symmetric_slice_sphere};
 use crate::camera::CameraGeometry;
 use crate::cascade_state::{CascadeState, HeldSlot, held_box};
 use crate::light::unit;
+use crate::light_prism::LightPrism;
 use crate::mapping::{LightDirection, ShadowSample, ShadowTransform, project_dmat};
 use crate::rays::Rays;
 use crate::split::CascadeBlend;
@@ -744,28 +745,13 @@ fn caster_depth_over(
     xy_lo: DVec2,
     xy_hi: DVec2,
 ) -> Result<Option<(f64, f64)>, FrustumError> {
-    use crate::geometry::DPlane;
-    let row = |r: usize| {
-        let m = light_from_world;
-        DVec3::new(m.x_axis[r], m.y_axis[r], m.z_axis[r])
-    };
-    let (rx, ry, rz) = (row(0), row(1), row(2));
-    let boxed = casters.transformed(&light_from_world.as_mat4());
-    let pad = 1.0 + f64::from(boxed.size().max_element());
-    // The light frame is a rotation, so light-space coordinates are dot products.
-    let prism = [
-        DPlane::new(rx, -xy_lo.x),
-        DPlane::new(-rx, xy_hi.x),
-        DPlane::new(ry, -xy_lo.y),
-        DPlane::new(-ry, xy_hi.y),
-        DPlane::new(rz, -(f64::from(boxed.min.z) - pad)),
-        DPlane::new(-rz, f64::from(boxed.max.z) + pad),
-    ];
-    let body = ConvexBody::from_planes_aabb(&prism, &casters.corners(), casters)?;
-    let mut range: Option<(f64, f64)> = None;
-    for v in body.vertices() {
-        let d = -rz.dot(v.as_dvec3());
-        range = Some(range.map_or((d, d), |(a, b)| (a.min(d), b.max(d))));
-    }
-    Ok(range)
+    let casters = casters.validate()?;
+    // Points within f32 rounding of the box and the prism count as inside.
+    let scale = casters.min.abs().max(casters.max.abs()).max_element();
+    let tolerance = 8.0 * f64::from(f32::EPSILON) * f64::from(scale.max(f32::MIN_POSITIVE));
+    let prism = LightPrism::new(light_from_world, xy_lo, xy_hi);
+    // Distance is minus the light-space z (which points toward the light).
+    Ok(prism
+        .box_depth_range(&casters, tolerance)
+        .map(|(z_lo, z_hi)| (-z_hi, -z_lo)))
 }

@@ -92,6 +92,7 @@ mod error;
 mod frustum;
 mod geometry;
 mod light;
+mod light_prism;
 mod mapping;
 pub mod math;
 mod predict;
@@ -118,6 +119,7 @@ pub use error::FrustumError;
 pub use frustum::Frustum;
 pub use geometry::{Aabb, Plane, Sphere};
 pub use light::{Light, directional_light_from_world};
+pub use light_prism::LightPrism;
 pub use mapping::{
     LightDirection, ShadowMapping, ShadowSample, ShadowTransform, UV_FROM_CLIP, is_invertible,
 };

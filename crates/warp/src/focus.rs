@@ -4,7 +4,7 @@
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 use shadowmap_frustum::{
-    Aabb, Camera, ConvexBody, Frustum, LightDirection, MAX_BODY_VERTICES,
+    Aabb, Camera, ConvexBody, Frustum, LightDirection, LightPrism, MAX_BODY_VERTICES,
     MAX_FRUSTUM_AABB_VERTICES, SceneBounds, ShadowTransform, ValidCamera, math,
 };
 
@@ -467,73 +467,14 @@ fn caster_points(rot: &DMat4, receivers: &[DVec3], b: &Bounds, caster_box: &Aabb
         .max(hi.abs())
         .max_element()
         .max(scale_of(receivers));
-    let tol = 1e-9 * scale;
-    // Light-space x and y of a world point (rows of the rotation).
-    let row = |r: usize| DVec3::new(rot.x_axis[r], rot.y_axis[r], rot.z_axis[r]);
-    let (rx, ry, rz) = (row(0), row(1), row(2));
-    let in_prism_xy = |x: f64, y: f64| {
-        x >= b.min.x - tol && x <= b.max.x + tol && y >= b.min.y - tol && y <= b.max.y + tol
-    };
-    let in_prism = |p: DVec3| in_prism_xy(rx.dot(p), ry.dot(p));
-    let in_box =
-        |p: DVec3| p.cmpge(lo - DVec3::splat(tol)).all() && p.cmple(hi + DVec3::splat(tol)).all();
+    let prism = LightPrism::new(rot, b.min.truncate(), b.max.truncate());
     let mut cands: ArrayVec<DVec3, 128> = ArrayVec::new();
-    // The vertices of box ∩ prism: box corners inside the prism, box edges crossing
-    // a side of the prism, and the prism's four edges (lines along the light)
-    // crossing a face of the box.
-    let corner = |i: usize| {
-        DVec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        )
-    };
-    // The corners' light-space x and y, shared by the edges that end there.
-    let light_xy: [[f64; 2]; 8] = core::array::from_fn(|i| [rx.dot(corner(i)), ry.dot(corner(i))]);
-    for i in 0..8 {
-        let p = corner(i);
-        if in_prism_xy(light_xy[i][0], light_xy[i][1]) {
-            let _ = cands.try_push(p);
-        }
-        for bit in [1usize, 2, 4] {
-            if i & bit != 0 {
-                continue;
-            }
-            let q = corner(i | bit);
-            for (axis, value) in [(0, b.min.x), (0, b.max.x), (1, b.min.y), (1, b.max.y)] {
-                let (a, c) = (light_xy[i][axis], light_xy[i | bit][axis]);
-                if (a - value) * (c - value) < 0.0 {
-                    let x = p + (q - p) * ((value - a) / (c - a));
-                    if in_prism(x) {
-                        let _ = cands.try_push(x);
-                    }
-                }
-            }
-        }
-    }
-    for (x, y) in [
-        (b.min.x, b.min.y),
-        (b.max.x, b.min.y),
-        (b.min.x, b.max.y),
-        (b.max.x, b.max.y),
-    ] {
-        // World line rx * x + ry * y + rz * t (the rows are orthonormal).
-        let base = rx * x + ry * y;
-        for axis in 0..3 {
-            if rz[axis].abs() < 1e-12 {
-                continue;
-            }
-            for value in [lo[axis], hi[axis]] {
-                let p = base + rz * ((value - base[axis]) / rz[axis]);
-                if p.is_finite() && in_box(p) {
-                    let _ = cands.try_push(p);
-                }
-            }
-        }
-    }
+    prism.box_vertices(caster_box, 1e-9 * scale, |p| {
+        let _ = cands.try_push(p);
+    });
     // Keep the candidates that matter for the depth range: the highest toward the
     // light (all of them when they fit).
-    let z_of = |p: &DVec3| rz.dot(*p);
+    let z_of = |p: &DVec3| prism.light_z(*p);
     for p in &cands {
         if out.try_push(*p).is_err() {
             // Full: replace the lowest point if this one is higher.
