@@ -27,6 +27,7 @@
 //! the rendered pixels). Rays whose neighbours fall into another map layer (a cascade
 //! boundary) or outside the map are left out.
 
+use arrayvec::ArrayVec;
 use glam::{DVec2, DVec3, Vec3};
 
 use crate::{Aabb, Camera, FrustumError, LightDirection, ShadowMapping, math};
@@ -236,13 +237,14 @@ pub fn predict_errors(
     };
     let screen =
         Screen::new(camera, options.viewport_height)?.with_depth_range(options.depth_range);
-    let mut errors = [[0.0f64; MAX_PREDICT_RAYS]; MAX_PREDICT_CANDIDATES];
-    let mut counts = [0usize; MAX_PREDICT_CANDIDATES];
+    // Uninitialized storage: only what a pass writes is read.
+    let mut errors: [RayErrors; MAX_PREDICT_CANDIDATES] =
+        core::array::from_fn(|_| RayErrors::new());
     // Front-lit shared rays first (without a light: every shared ray, twice); then
     // every shared ray; then each candidate's own rays.
     let passes = [(light, true), (None, true), (None, false)];
     for (lit_by, shared) in passes {
-        counts = [0; MAX_PREDICT_CANDIDATES];
+        errors.iter_mut().for_each(ArrayVec::clear);
         let pass = Pass {
             screen: &screen,
             receivers,
@@ -250,16 +252,19 @@ pub fn predict_errors(
             lit_by,
             shared,
         };
-        pass.run(candidates, &mut errors, &mut counts);
-        if counts[..n].iter().any(|&c| c > 0) {
+        pass.run(candidates, &mut errors);
+        if errors[..n].iter().any(|e| !e.is_empty()) {
             break;
         }
     }
     for (i, slot) in out.iter_mut().enumerate() {
-        *slot = summarize(&mut errors[i][..counts[i]], options.percentile);
+        *slot = summarize(&mut errors[i], options.percentile);
     }
     Ok(())
 }
+
+/// One candidate's errors, one per ray.
+type RayErrors = ArrayVec<f64, MAX_PREDICT_RAYS>;
 
 /// One pass of [`predict_errors`] over the ray grid.
 struct Pass<'a> {
@@ -276,8 +281,7 @@ impl Pass<'_> {
     fn run(
         &self,
         candidates: &[(&dyn ShadowMapping, u32)],
-        errors: &mut [[f64; MAX_PREDICT_RAYS]; MAX_PREDICT_CANDIDATES],
-        counts: &mut [usize; MAX_PREDICT_CANDIDATES],
+        errors: &mut [RayErrors; MAX_PREDICT_CANDIDATES],
     ) {
         let n = candidates.len();
         let (columns, rows) = self.grid;
@@ -310,8 +314,8 @@ impl Pass<'_> {
                 }
                 for (i, m) in ray[..n].iter().enumerate() {
                     if let Some(m) = m {
-                        errors[i][counts[i]] = *m;
-                        counts[i] += 1;
+                        // At most one error per ray, `MAX_PREDICT_RAYS` rays.
+                        let _ = errors[i].try_push(*m);
                     }
                 }
             }
