@@ -102,18 +102,36 @@ pub(crate) fn dual_axis(
     toward: DVec3,
     fallback: DVec3,
 ) -> DVec3 {
+    dual_axis_below(l, pts, up_hint, toward, fallback, f64::INFINITY)
+        .unwrap_or_else(|| facing(fallback, toward, up_hint))
+}
+
+/// [`dual_axis`] where its [`cost`] is below `bound`, else `None`. The search
+/// starts from the bound, so a candidate stops being costed once it reaches it:
+/// deciding between one cut paraboloid and a dual map ([`single_cost`]) costs less
+/// than finding the dual map's axis.
+pub(crate) fn dual_axis_below(
+    l: DVec3,
+    pts: &[DVec3; 8],
+    up_hint: DVec3,
+    toward: DVec3,
+    fallback: DVec3,
+    bound: f64,
+) -> Option<DVec3> {
     let samples = samples(l, pts);
-    let mut best = fallback;
-    let mut best_cost = f64::INFINITY;
+    let mut best = None;
+    let mut best_cost = bound;
+    let mut usable = false;
     let mut consider = |a: DVec3| {
         let Some(a) = a.try_normalize() else {
             return;
         };
+        usable = true;
         // The running maximum only grows: stop once it cannot win.
         let c = cost_below(a, &samples, best_cost);
         if c < best_cost {
             best_cost = c;
-            best = a;
+            best = Some(a);
         }
     };
     consider(up_hint);
@@ -126,23 +144,35 @@ pub(crate) fn dual_axis(
             }
         }
     }
-    let s = best.dot(toward);
+    // Without any usable candidate, the fallback (if it beats the bound).
+    let best = match best {
+        Some(a) => a,
+        None if !usable && cost_below(fallback, &samples, bound) < bound => fallback,
+        None => return None,
+    };
+    Some(facing(best, toward, up_hint))
+}
+
+/// `axis` signed so that it faces `toward` (else away from `up_hint`).
+fn facing(axis: DVec3, toward: DVec3, up_hint: DVec3) -> DVec3 {
+    let s = axis.dot(toward);
     let flip = if s == 0.0 {
-        best.dot(up_hint) > 0.0
+        axis.dot(up_hint) > 0.0
     } else {
         s < 0.0
     };
-    if flip { -best } else { best }
+    if flip { -axis } else { axis }
 }
 
 /// Side of one paraboloid over the side of each of a dual map's two at the same
 /// texel budget (`k` layers of side `sqrt(budget / k)`).
 const SINGLE_SIDE_GAIN: f64 = core::f64::consts::SQRT_2;
 
-/// Whether one cut paraboloid (front axis the cone's, cut to the cone widened by
-/// `margin`: `zoom = tan((half_angle + margin) / 2)`) is predicted to
-/// sample the truncated frustum `pts` at least as finely as the dual map with front
-/// axis `dual`, at the same texel budget. A cut map's texel at angle `theta` from its
+/// The predicted cost of one cut paraboloid (front axis the cone's, cut to the cone
+/// widened by `margin`: `zoom = tan((half_angle + margin) / 2)`) over the truncated
+/// frustum `pts`, comparable with a dual map's [`cost`] at the same texel budget: the
+/// cut map samples at least as finely as the dual map unless that map's cost is
+/// below it ([`dual_axis_below`]). A cut map's texel at angle `theta` from its
 /// axis spans `zoom (1 + cos theta)` times what a dual map's spans at its centre, and
 /// it has [`SINGLE_SIDE_GAIN`] times the texels per side:
 ///
@@ -150,21 +180,13 @@ const SINGLE_SIDE_GAIN: f64 = core::f64::consts::SQRT_2;
 /// single: max_i zoom (|v_i| + a . v_i) / s_i / sqrt(2)
 /// dual:   max_i (|v_i| + |a' . v_i|) / s_i          (the cost of `dual_axis`)
 /// ```
-pub(crate) fn single_is_finer(
-    l: DVec3,
-    pts: &[DVec3; 8],
-    cone: DCone,
-    margin: f64,
-    dual: DVec3,
-) -> bool {
+pub(crate) fn single_cost(l: DVec3, pts: &[DVec3; 8], cone: DCone, margin: f64) -> f64 {
     let (axis, zoom) = (cone.axis, zoom_for_half_angle(cone.half_angle + margin));
-    let samples = samples(l, pts);
-    let single = samples
+    samples(l, pts)
         .iter()
         .map(|s| zoom * (s.length + axis.dot(s.v)) * s.inv_size)
         .fold(0.0, f64::max)
-        / SINGLE_SIDE_GAIN;
-    !(single > cost_below(dual, &samples, f64::INFINITY))
+        / SINGLE_SIDE_GAIN
 }
 
 #[cfg(test)]

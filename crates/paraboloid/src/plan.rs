@@ -8,7 +8,7 @@ use crate::cone::{
     Cone, ConeFit, DCone, MIN_ZOOM, minimal_fit, paper_fit, round_up_f32, zoom_for_half_angle,
 };
 use crate::map::{MapOptions, ParaboloidMap, ParaboloidMode, Side, check_depth_range};
-use crate::orient::{dual_axis, single_is_finer};
+use crate::orient::{dual_axis, dual_axis_below, single_cost};
 
 /// Knobs of [`IpsmPlan`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -283,11 +283,27 @@ impl IpsmPlan {
                 }
             }
         };
-        let dual = || dual_axis(l, &pts, up_hint, fallback_axis, fallback_axis);
+        // The dual map's axis search, run at most once (the single-or-dual decision
+        // and the dual map both need it).
+        let dual_found = core::cell::Cell::new(None);
+        let dual = || {
+            dual_found.get().unwrap_or_else(|| {
+                let axis = dual_axis(l, &pts, up_hint, fallback_axis, fallback_axis);
+                dual_found.set(Some(axis));
+                axis
+            })
+        };
         let reason = match (reason, cone) {
             (None, Some(c)) if c.half_angle + margin >= max_single => Some(DualReason::ConeTooWide),
-            (None, Some(c)) if !single_is_finer(l, &pts, c, margin, dual()) => {
-                Some(DualReason::DualFiner)
+            (None, Some(c)) => {
+                // The dual map wins where some axis costs less than the cut map.
+                let single = single_cost(l, &pts, c, margin);
+                dual_axis_below(l, &pts, up_hint, fallback_axis, fallback_axis, single).map(
+                    |axis| {
+                        dual_found.set(Some(axis));
+                        DualReason::DualFiner
+                    },
+                )
             }
             (r, _) => r,
         };
