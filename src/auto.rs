@@ -4,7 +4,8 @@ use arrayvec::ArrayVec;
 use shadowmap_frustum::ShadowMapping;
 use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 
-use crate::fit::{FitError, FitInput, FitState, fit_candidate, predicted_percentiles};
+use crate::cascaded::CountChoice;
+use crate::fit::{FitError, FitInput, FitState, fit_candidate_with, predicted_percentiles};
 use crate::shadow::Shadow;
 use crate::technique::{CascadePlan, Technique};
 
@@ -43,8 +44,18 @@ pub(crate) fn fit_auto(
 ) -> Result<Shadow, FitError> {
     let candidates = auto_candidates(plan);
     let mut fitted: [Option<Shadow>; AUTO_CANDIDATE_COUNT] = Default::default();
+    let mut tight_fitted = false;
     for (slot, technique) in fitted.iter_mut().zip(&candidates) {
-        *slot = fit_candidate(technique, input, state).ok();
+        // The stable cascades' count is predicted by the same tight fits as the
+        // tight cascades': fitted after them, they keep the count just chosen.
+        let count = match technique {
+            Technique::StableCascades(_) if tight_fitted => CountChoice::Keep,
+            _ => CountChoice::Predict,
+        };
+        *slot = fit_candidate_with(technique, input, state, count).ok();
+        if matches!(technique, Technique::TightCascades(_)) {
+            tight_fitted = slot.is_some();
+        }
     }
     let percentiles = predict(&fitted, input)?;
     let chosen = state

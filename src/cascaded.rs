@@ -15,12 +15,24 @@ use crate::technique::CascadePlan;
 
 /// Stable or tight cascades (PSSM over the depth bounds), their count chosen by
 /// [`choose_splits`] and kept in `state` with the stable maps' extents.
+/// How a cascaded fit gets its count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum CountChoice {
+    /// Predicted this frame ([`choose_splits`]).
+    Predict,
+    /// The count in the state, predicted this frame by another fit of the same
+    /// prediction (`auto` fits the tight cascades, then the stable ones, whose count
+    /// is predicted by the same tight fits): the prediction is not run twice.
+    Keep,
+}
+
 pub(crate) fn fit_cascades(
     plan: &CascadePlan,
     stable: bool,
     direction: Vec3,
     input: &FitInput<'_>,
     state: &mut CascadeState,
+    choice: CountChoice,
 ) -> Result<(Fitted, u32), FitError> {
     let camera = ValidCamera::new(input.camera)?;
     let mut count = state.count();
@@ -29,7 +41,7 @@ pub(crate) fn fit_cascades(
         let set = CascadeSet::fit_valid(&camera, direction, splits, &options).ok()?;
         Some(Candidate::Cascades(set))
     };
-    let splits = choose_splits(plan, input, &camera, &mut count, &tight)?;
+    let splits = choose_splits(plan, input, &camera, &mut count, &tight, choice)?;
     state.set_count(count);
     let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
     let fit = cascade_options(input, layers, direction)?
@@ -71,7 +83,14 @@ pub(crate) fn fit_warped(
         Some(Candidate::Warped(fit(splits).ok()?, eye, forward))
     };
     let mut count = state.count();
-    let splits = choose_splits(plan, input, &camera, &mut count, &warped)?;
+    let splits = choose_splits(
+        plan,
+        input,
+        &camera,
+        &mut count,
+        &warped,
+        CountChoice::Predict,
+    )?;
     state.set_count(count);
     let cascades = fit(&splits)?;
     let fitted = Fitted::WarpedCascades {
@@ -199,6 +218,7 @@ fn choose_splits(
     camera: &ValidCamera,
     kept: &mut usize,
     fit: &dyn Fn(&CascadeSplits, u32) -> Option<Candidate>,
+    choice: CountChoice,
 ) -> Result<CascadeSplits, FitError> {
     let (near, far) = match input.depth_bounds {
         Some(bounds) => bounds.clamped_to_valid(camera),
@@ -214,6 +234,9 @@ fn choose_splits(
     let splits_of = |k: usize| -> Result<CascadeSplits, FitError> {
         Ok(CascadeSplits::new(&scheme, k, near, far)?.with_overlap(plan.overlap)?)
     };
+    if choice == CountChoice::Keep && allowed(*kept) {
+        return splits_of(*kept);
+    }
     let mut candidates: ArrayVec<(usize, Candidate), MAX_CASCADES> = ArrayVec::new();
     for k in (1..=max).filter(|k| allowed(*k)) {
         let count = u32::try_from(k).unwrap_or(u32::MAX);
