@@ -146,6 +146,8 @@ mod sample_error;
 mod shadow;
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 mod technique;
+#[cfg(all(test, feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod test_views;
 
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 pub use auto::{AUTO_CANDIDATE_COUNT, auto_candidates};

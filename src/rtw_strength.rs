@@ -93,28 +93,11 @@ mod tests {
     use super::*;
     use alloc::vec::Vec;
     use glam::Vec3;
-    use shadowmap_frustum::{Aabb, Projection, SceneBounds};
-    use shadowmap_warp::{UniformOptions, uniform_focused};
 
     /// A camera 10 m over a ground plane looking down at 45°, the sun straight down,
     /// and the eye samples of a grid of ground points it sees.
     fn ground() -> (Camera, Vec3, ShadowTransform, Vec<EyeSample>) {
-        let camera = Camera::look_to(
-            Vec3::new(0.0, 10.0, 0.0),
-            Vec3::new(0.0, -1.0, -1.0),
-            Vec3::Y,
-            Projection::perspective(1.0, 1.5, 0.5, 100.0),
-        )
-        .unwrap();
-        let light = Vec3::NEG_Y;
-        let floor = Aabb::new(Vec3::new(-40.0, -1.0, -60.0), Vec3::new(40.0, 0.0, 0.0));
-        let base = uniform_focused(
-            &camera,
-            light,
-            &SceneBounds::whole(floor),
-            &UniformOptions::default(),
-        )
-        .unwrap();
+        let (camera, light, base) = crate::test_views::looking_down_at_the_ground();
         let mut samples = Vec::new();
         for i in 0..40 {
             for j in 0..40 {

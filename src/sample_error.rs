@@ -96,8 +96,6 @@ pub(crate) fn percentile_of(values: &mut [f64], percentile: f64) -> Option<f64> 
 mod tests {
     use super::*;
     use glam::Vec3;
-    use shadowmap_frustum::{Aabb, Projection, SceneBounds};
-    use shadowmap_warp::{UniformOptions, uniform_focused};
 
     fn sample(position: Vec3, normal: Vec3) -> EyeSample {
         EyeSample {
@@ -111,22 +109,7 @@ mod tests {
     /// see, and still measures a surface the light does not reach (on the bisector's plane).
     #[test]
     fn the_error_follows_the_side_and_the_coverage() {
-        let camera = Camera::look_to(
-            Vec3::new(0.0, 10.0, 0.0),
-            Vec3::new(0.0, -1.0, -1.0),
-            Vec3::Y,
-            Projection::perspective(1.0, 1.5, 0.5, 100.0),
-        )
-        .unwrap();
-        let floor = Aabb::new(Vec3::new(-40.0, -1.0, -60.0), Vec3::new(40.0, 0.0, 0.0));
-        let light = Vec3::NEG_Y;
-        let map = uniform_focused(
-            &camera,
-            light,
-            &SceneBounds::whole(floor),
-            &UniformOptions::default(),
-        )
-        .unwrap();
+        let (camera, light, map) = crate::test_views::looking_down_at_the_ground();
         let lit = [sample(Vec3::new(0.0, 0.0, -10.0), Vec3::Y)];
         let error = |samples: &[EyeSample], side: f64| {
             let l = LightDirection::Directional(light);

@@ -63,6 +63,13 @@ impl Mesh {
             .map(|t| t.map(|k| self.positions[k as usize]))
     }
 
+    /// The triangles with `f32` corners, as the depth passes (GPU and CPU) and the
+    /// caster subdivisions take them.
+    #[must_use]
+    pub fn triangles_f32(&self) -> Vec<[glam::Vec3; 3]> {
+        self.triangles().map(|t| t.map(DVec3::as_vec3)).collect()
+    }
+
     /// Checks that every position is finite and every index is in range.
     ///
     /// # Errors

@@ -502,8 +502,7 @@ impl Technique {
         if let Some(shadow) = self.shadow.rtw() {
             // The depth pass warps vertices only: the same crack-free caster
             // subdivision as the GPU depth pass, for a map of this side.
-            let triangles: Vec<[Vec3; 3]> =
-                mesh.triangles().map(|t| t.map(DVec3::as_vec3)).collect();
+            let triangles: Vec<[Vec3; 3]> = mesh.triangles_f32();
             let subdivision = RtwSubdivision::default().with_resolution(side);
             let mut pieces = Vec::new();
             subdivide_for_rtw(&shadow, &triangles, &subdivision, &mut pieces);
@@ -543,7 +542,7 @@ impl Technique {
     ) -> Result<DepthMap, EvalError> {
         let side = self.shadow.layer_side();
         let layers = self.layers();
-        let triangles: Vec<[Vec3; 3]> = mesh.triangles().map(|t| t.map(DVec3::as_vec3)).collect();
+        let triangles: Vec<[Vec3; 3]> = mesh.triangles_f32();
         let sub = SubdivisionOptions::default().with_resolution(side);
         let mut out = DepthMap::cleared(side, side, layers, map.reversed_z)?;
         let per_layer = side as usize * side as usize;
@@ -594,7 +593,7 @@ fn rasterize_cube(
     mesh: &Mesh,
     options: &RasterOptions,
 ) -> Result<DepthMap, EvalError> {
-    let triangles: Vec<[Vec3; 3]> = mesh.triangles().map(|t| t.map(DVec3::as_vec3)).collect();
+    let triangles: Vec<[Vec3; 3]> = mesh.triangles_f32();
     let mut pieces = Vec::new();
     let mut faces = Vec::with_capacity(cube.faces.len());
     for (i, f) in cube.faces.iter().enumerate() {

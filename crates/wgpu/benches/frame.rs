@@ -116,9 +116,7 @@ fn packing(c: &mut Criterion) {
     // tables, redone whenever the tables change (every frame).
     let city: Vec<[Vec3; 3]> = shadowmap_eval::scene::Scene::city_block(1)
         .mesh
-        .triangles()
-        .map(|t| t.map(glam::DVec3::as_vec3))
-        .collect();
+        .triangles_f32();
     let subdivision = RtwSubdivision::default().with_resolution(2048);
     let mut casters = Vec::new();
     let pieces = subdivide_for_rtw(&rtw, &city, &subdivision, &mut casters);
@@ -193,9 +191,7 @@ fn packing(c: &mut Criterion) {
 fn city_casters() -> Vec<[Vec3; 3]> {
     shadowmap_eval::scene::Scene::city_block(1)
         .mesh
-        .triangles()
-        .map(|t| t.map(glam::DVec3::as_vec3))
-        .collect()
+        .triangles_f32()
 }
 
 /// A `width x height` G-buffer of the bench camera looking at the ground plane of

@@ -37,7 +37,7 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 use std::time::Instant;
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use shadowmap::frustum::{Camera, Light, Projection, ShadowTransform};
 use shadowmap::{FitInput, LightKind, RtwPlan, Technique, fit};
 use shadowmap_eval::bvh::Bvh;
@@ -428,11 +428,7 @@ fn main() -> Result<(), Error> {
     let ctx = GpuContext::new_headless_with_features(GpuProfiler::FEATURES)?;
     let mut profiler = GpuProfiler::new(&ctx, 16);
     let scene = Scene::city_block(1);
-    let triangles: Vec<[Vec3; 3]> = scene
-        .mesh
-        .triangles()
-        .map(|t| t.map(DVec3::as_vec3))
-        .collect();
+    let triangles: Vec<[Vec3; 3]> = scene.mesh.triangles_f32();
     let camera = Camera::look_at(
         Vec3::new(10.0, 18.0, 120.0),
         Vec3::new(0.0, 4.0, 0.0),

@@ -75,11 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let ctx = GpuContext::new_headless()?;
     eprintln!("adapter: {}", ctx.describe());
     let scene = Scene::city_block(1);
-    let triangles: Vec<[Vec3; 3]> = scene
-        .mesh
-        .triangles()
-        .map(|t| t.map(glam::DVec3::as_vec3))
-        .collect();
+    let triangles: Vec<[Vec3; 3]> = scene.mesh.triangles_f32();
     let scene_bounds = scene.scene_bounds().ok_or("empty scene")?;
     let camera = Camera::look_at(
         Vec3::new(-20.0, 25.0, 110.0),

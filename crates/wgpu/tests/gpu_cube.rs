@@ -34,11 +34,7 @@ fn blocks(cube: &CubeMap) -> Vec<shadowmap_wgpu::uniforms::MatrixShadowRaw> {
 /// inside the view (several faces kept).
 fn lamp_among_buildings() -> (Scene, Vec<[Vec3; 3]>, Camera, Light) {
     let scene = Scene::city_block(1);
-    let tris = scene
-        .mesh
-        .triangles()
-        .map(|t| t.map(glam::DVec3::as_vec3))
-        .collect();
+    let tris = scene.mesh.triangles_f32();
     let camera = Camera::look_at(
         Vec3::new(0.0, 40.0, 90.0),
         Vec3::new(0.0, 0.0, -20.0),
@@ -141,11 +137,7 @@ fn cube_frames_shadow_what_a_dpsm_shadows() {
         return;
     };
     let scene = Scene::city_block(1);
-    let tris: Vec<[Vec3; 3]> = scene
-        .mesh
-        .triangles()
-        .map(|t| t.map(glam::DVec3::as_vec3))
-        .collect();
+    let tris: Vec<[Vec3; 3]> = scene.mesh.triangles_f32();
     let camera = Camera::look_at(
         Vec3::new(0.0, 40.0, 90.0),
         Vec3::new(0.0, 0.0, -20.0),

@@ -37,12 +37,6 @@ fn camera() -> Camera {
 
 const LIGHT: Vec3 = Vec3::new(0.4, -1.0, 0.3);
 
-fn triangles(mesh: &Mesh) -> Vec<[Vec3; 3]> {
-    mesh.triangles()
-        .map(|t| t.map(glam::DVec3::as_vec3))
-        .collect()
-}
-
 fn mesh_of(tris: &[[Vec3; 3]]) -> Mesh {
     let mut m = Mesh::new();
     for t in tris {
@@ -180,7 +174,7 @@ fn matrix_case(
     t: &ShadowTransform,
     raw: shadowmap_wgpu::uniforms::MatrixShadowRaw,
 ) {
-    let tris = triangles(&scene().mesh);
+    let tris = scene().mesh.triangles_f32();
     let desc = DepthPassDesc::new(DepthTechnique::Matrix, RES).with_reversed_z(t.reversed_z);
     let result = compare(
         ctx,
@@ -238,7 +232,7 @@ fn cascades_render_one_layer_each_and_match() {
     let result = compare(
         &ctx,
         desc,
-        &[triangles(&scene().mesh)],
+        &[scene().mesh.triangles_f32()],
         &DepthUniforms::Matrix(&layers),
         &MatrixProjector::from(set),
     );
@@ -261,7 +255,7 @@ fn paraboloid_front_and_back_match() {
         .with_near(0.5);
     let shadow = fit_test(&Technique::Dpsm(dpsm), &lamp, 2);
     let map = shadow.paraboloid().unwrap();
-    let tris = triangles(&scene().mesh);
+    let tris = scene().mesh.triangles_f32();
     let options = SubdivisionOptions::default().with_resolution(RES);
     let mut front = Vec::new();
     let mut back = Vec::new();
@@ -327,7 +321,12 @@ fn rtw_matches_with_warped_vertices() {
         ("split", RtwSubdivision::default().with_resolution(RES)),
     ] {
         let mut tris = Vec::new();
-        subdivide_for_rtw(&shadow, &triangles(&scene().mesh), &subdivision, &mut tris);
+        subdivide_for_rtw(
+            &shadow,
+            &scene().mesh.triangles_f32(),
+            &subdivision,
+            &mut tris,
+        );
         let result = compare(&ctx, desc, &[tris], &uniforms, &RtwProjector::from(shadow));
         assert_close(&format!("rtw, {name}"), result.0, result.1);
     }
@@ -454,7 +453,7 @@ fn rtw_depth_pass_with_gpu_built_tables_matches_cpu_tables() {
     let mut casters = Vec::new();
     subdivide_for_rtw(
         &shadow,
-        &triangles(&scene().mesh),
+        &scene().mesh.triangles_f32(),
         &RtwSubdivision::default().with_resolution(RES),
         &mut casters,
     );

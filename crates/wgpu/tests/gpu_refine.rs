@@ -35,11 +35,7 @@ use wgpu::util::DeviceExt;
 const RES: u32 = 256;
 
 fn city() -> Vec<[Vec3; 3]> {
-    Scene::city_block(1)
-        .mesh
-        .triangles()
-        .map(|t| t.map(glam::DVec3::as_vec3))
-        .collect()
+    Scene::city_block(1).mesh.triangles_f32()
 }
 
 /// The uniform fit of the depth tests (`gpu_depth.rs`) over the city block.

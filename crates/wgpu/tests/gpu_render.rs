@@ -47,7 +47,7 @@ fn scene() -> Vec<[Vec3; 3]> {
     m.push_box(DVec3::new(2.0, 0.0, -8.0), DVec3::new(5.0, 3.0, -5.0));
     m.push_box(DVec3::new(0.0, 2.0, 2.0), DVec3::new(2.0, 2.5, 4.0));
     m.push_box(DVec3::new(6.0, 0.0, 3.0), DVec3::new(6.3, 7.0, 3.3));
-    m.triangles().map(|t| t.map(glam::DVec3::as_vec3)).collect()
+    m.triangles_f32()
 }
 
 fn bounds() -> Aabb {

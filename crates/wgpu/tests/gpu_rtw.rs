@@ -451,11 +451,7 @@ fn the_gpu_gbuffer_is_the_ray_traced_one() {
     )
     .unwrap();
     let (width, height) = (160, 90);
-    let triangles: Vec<[Vec3; 3]> = scene
-        .mesh
-        .triangles()
-        .map(|t| t.map(DVec3::as_vec3))
-        .collect();
+    let triangles: Vec<[Vec3; 3]> = scene.mesh.triangles_f32();
     let (positions, normals) = ctx
         .scoped(|ctx| {
             let mesh = MeshBuffers::from_triangles(ctx, &triangles)?;

@@ -8,7 +8,7 @@
 //! eval's CPU mask. Projective shadows on the GPU equal their CPU reference on the
 //! fence and the city block.
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use shadowmap::Fitted;
 use shadowmap_eval::bvh::Bvh;
 use shadowmap_eval::config::{ConfigOptions, Configuration, standard_configurations};
@@ -39,14 +39,6 @@ fn configuration(name: &str) -> Configuration {
         .into_iter()
         .find(|c| c.name == name)
         .unwrap()
-}
-
-fn triangles(scene: &Scene) -> Vec<[Vec3; 3]> {
-    scene
-        .mesh
-        .triangles()
-        .map(|t| t.map(DVec3::as_vec3))
-        .collect()
 }
 
 /// Is the eye in some caster's shadow (inside a volume)?
@@ -84,7 +76,7 @@ fn volume_vs_rays(
     let bvh = Bvh::build(&scene.mesh).unwrap();
     let gbuffer = GBuffer::trace(&bvh, camera, W, H).unwrap();
     let truth = CpuMask::ray_traced(&gbuffer, &bvh, light).unwrap();
-    let mut volumes = VolumeScene::new(&triangles(scene)).unwrap();
+    let mut volumes = VolumeScene::new(&scene.mesh.triangles_f32()).unwrap();
     let gpu = VolumeRenderer::new()
         .render_mask(ctx, &mut volumes, camera, light, (W, H), method)
         .unwrap();
@@ -205,7 +197,7 @@ fn z_fail_is_right_with_the_camera_inside_a_volume() {
 #[test]
 fn open_casters_are_reported() {
     let room = Scene::indoor_room();
-    let scene = VolumeScene::new(&triangles(&room)).unwrap();
+    let scene = VolumeScene::new(&room.mesh.triangles_f32()).unwrap();
     assert!(scene.open_triangles() > 0);
     assert!(scene.first_open_edge().is_some());
     // The furniture (closed boxes and the column) casts.
@@ -290,7 +282,7 @@ impl<'c> ReportFrame<'c> {
             truth,
             samples,
             pixels_per_radian: screen.pixels_per_radian().unwrap() as f32,
-            triangles: triangles(&config.scene),
+            triangles: config.scene.mesh.triangles_f32(),
             gbuffer,
         }
     }
@@ -461,7 +453,7 @@ const MASK_SIDE: u32 = 2048;
 /// number of differing pixels.
 fn projective_vs_cpu(ctx: &GpuContext, name: &str, config: &Configuration) -> usize {
     let (scene, camera, light) = (&config.scene, config.camera(), &config.light);
-    let tris = triangles(scene);
+    let tris = scene.mesh.triangles_f32();
     let positions: Vec<Vec3> = tris.iter().flatten().copied().collect();
     let indices: Vec<[u32; 3]> = (0..tris.len() as u32)
         .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
@@ -536,7 +528,7 @@ fn gpu_silhouette_is_the_cpu_silhouette() {
     };
     for name in ["facing_spot", "point_inside", "behind"] {
         let config = configuration(name);
-        let scene = VolumeScene::new(&triangles(&config.scene)).unwrap();
+        let scene = VolumeScene::new(&config.scene.mesh.triangles_f32()).unwrap();
         let gpu = GpuSilhouette::new(&ctx, scene.casters()).unwrap();
         let mut found = gpu.find(&ctx, &config.light).unwrap();
         // The CPU reference, through the volume renderer's own update.
@@ -566,8 +558,8 @@ fn a_reused_volume_renderer_renders_what_a_fresh_one_does() {
         return;
     };
     let (city, room) = (configuration("behind"), configuration("point_inside"));
-    let mut scenes =
-        [city.clone(), room.clone()].map(|c| VolumeScene::new(&triangles(&c.scene)).unwrap());
+    let mut scenes = [city.clone(), room.clone()]
+        .map(|c| VolumeScene::new(&c.scene.mesh.triangles_f32()).unwrap());
     let mut reused = VolumeRenderer::new();
     let frames = [
         (0, &city, (W, H), VolumeMethod::ZPass),

@@ -136,7 +136,7 @@ fn options() -> RenderOptions {
 }
 
 fn triangles() -> Vec<[Vec3; 3]> {
-    mesh().triangles().map(|t| t.map(DVec3::as_vec3)).collect()
+    mesh().triangles_f32()
 }
 
 fn check_against_cpu(ctx: &GpuContext, renderer: &mut HeadlessRenderer, reversed_z: bool) {
