@@ -1,9 +1,11 @@
 // techniques: rtw
 // Depth pass of rectilinear texture warping: the base projection, then each texture
-// axis warped through its table. The tables are filtered by hand with the exact
-// texel-centre linear, clamp-to-edge semantics of `shadowmap_rtw::forward_warp`
-// (the sampler of rtw_sample.wgsl, composed in), so the CPU and the GPU agree. Casters
-// must be subdivided: the warp is piecewise linear between table texel centres.
+// axis warped through its table (one layer per base: a single map, or each kept face
+// of a cube map in its layer's top-left corner). The tables are filtered by hand
+// with the exact texel-centre linear, clamp-to-edge semantics of
+// `shadowmap_rtw::forward_warp` (the sampler of rtw_sample.wgsl, composed in), so the
+// CPU and the GPU agree. Casters must be subdivided: the warp is piecewise linear
+// between table texel centres.
 //
 // The warped position is snapped to the rasterizer's 1/256-pixel grid here. Where the
 // warp compresses (low importance), triangles become slivers with a depth slope of
@@ -19,6 +21,12 @@ struct RtwShadow {
     // x: u-table texels, y: v-table texels, z: reversed-Z, w: map texels per side
     // (0: no snapping).
     sizes: vec4<u32>,
+    // x, y: where the u and the v table start in `rtw_tables`.
+    table_offsets: vec4<u32>,
+    // x, y: scale of the warped uv into the layer's top-left corner (1: the map
+    // fills the layer; cube faces of different sizes); z: the near plane's w where
+    // the casters were cut to a window (unused here).
+    layer: vec4<f32>,
 }
 
 // Subpixel steps per pixel of the rasterizer's fixed-point grid.
@@ -42,9 +50,9 @@ fn vs_main(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
     let ndc = clip.xyz / clip.w;
     let uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
     let warped = vec2<f32>(
-        uv.x + rtw_sample(0u, rtw.sizes.x, uv.x),
-        uv.y + rtw_sample(rtw.sizes.x, rtw.sizes.y, uv.y),
-    );
+        uv.x + rtw_sample(rtw.table_offsets.x, rtw.sizes.x, uv.x),
+        uv.y + rtw_sample(rtw.table_offsets.y, rtw.sizes.y, uv.y),
+    ) * rtw.layer.xy;
     var snapped = warped;
     if rtw.sizes.w > 0u {
         // Pixels times the 2^8 subpixel steps of Vulkan/D3D rasterizers; the result

@@ -9,6 +9,10 @@ struct RtwShadow {
     uv_from_world: mat4x4<f32>,
     // x: u-table texels, y: v-table texels, z: reversed-Z.
     sizes: vec4<u32>,
+    // x, y: where the u and the v table start in `rtw_tables`.
+    table_offsets: vec4<u32>,
+    // x, y: scale of the warped uv into the layer's top-left corner (1 here).
+    layer: vec4<f32>,
 }
 
 @group(1) @binding(0) var<uniform> shadow: RtwShadow;
@@ -29,10 +33,10 @@ fn shadow_lookup(world: vec3<f32>, view_depth: f32, world_bias: f32, second: boo
     }
     let uv = h.xy / h.w;
     let warped = vec2<f32>(
-        uv.x + rtw_sample(0u, shadow.sizes.x, uv.x),
-        uv.y + rtw_sample(shadow.sizes.x, shadow.sizes.y, uv.y),
+        uv.x + rtw_sample(shadow.table_offsets.x, shadow.sizes.x, uv.x),
+        uv.y + rtw_sample(shadow.table_offsets.y, shadow.sizes.y, uv.y),
     );
-    return vec4<f32>(warped, h.z / h.w, 0.0);
+    return vec4<f32>(warped * shadow.layer.xy, h.z / h.w, 0.0);
 }
 
 fn shadow_blend_weight(world: vec3<f32>, view_depth: f32) -> f32 {

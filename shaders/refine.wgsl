@@ -13,9 +13,10 @@
 //   shorter diagonal), three edges 4, each refined again, down to `levels` halvings.
 //   The decision on an edge depends on its two endpoints alone and is symmetric in
 //   them, so a conforming mesh stays conforming (no T-junctions, no cracks).
-//   Over a paraboloid side, casters are first cut at the side's plane
-//   (`subdivide_for_rtw_clipped`: the part behind is left out). Pieces with a vertex
-//   the base cannot map are dropped, as on the CPU.
+//   Over a paraboloid side, casters are first cut at the side's plane, over a cube
+//   face at the five planes of its window's frustum (near plane first, then the
+//   sides; `subdivide_for_rtw_clipped`: the parts behind are left out). Pieces with
+//   a vertex the base cannot map are dropped, as on the CPU.
 // - Paraboloid grid (`shadowmap_paraboloid::subdivide_triangle`; Brabec et al., the
 //   image of an edge on a paraboloid is curved): each edge gets the fewest equal
 //   segments whose chords stay within `tolerance` texels of the curve (measured at
@@ -23,8 +24,9 @@
 //   triangle becomes the n^2 pieces of the barycentric grid, n the largest of its
 //   three edges.
 //
-// The base is a matrix (`uv_from_world`, orthographic or perspective) or one side of
-// a paraboloid map (the side is the layer). The RTW rule reads each layer's tables.
+// The base is a matrix per layer (`uv_from_world`, orthographic or perspective: one
+// map, or the kept faces of a cube map) or one side of a paraboloid map (the side is
+// the layer). The RTW rule reads each layer's tables.
 //
 // Three entry points over one bind group, `count` and `emit` with one invocation per
 // (caster, layer):
@@ -42,9 +44,13 @@
 //   testing keeps the minimum either way), and writes them as a triangle soup of
 //   `vec3<f32>` (9 floats a triangle).
 //
-// Every RTW node visited is one iteration of one loop (the counts per cap are summed
-// after the walk): llvmpipe ends a loop after 65535 iterations, so a caster refined
-// into more nodes than that is cut short there (real GPUs have no such bound).
+// Every RTW node visited is one iteration of one loop with no loop inside it (the
+// counts per cap are summed after the walk, a node's pieces are pushed without a
+// loop): llvmpipe ends a loop after 65535 iterations counted together with those of
+// the loops nested in it, and its invocation then writes nothing, so a caster
+// refined into more nodes than that is lost there (real GPUs have no such bound).
+// Measured: with the pieces pushed by a loop, walls of the city block refined into
+// 15,000 pieces over a cube face (about 40,000 iterations) were dropped.
 //
 // No workgroup memory and no subgroup operations: every invocation works alone and
 // meets the others only through atomics on integers, so the result depends on no
@@ -58,42 +64,46 @@ struct Paraboloid {
 }
 
 struct RefineLayer {
+    // The layer's base in the matrix mode.
+    uv_from_world: mat4x4<f32>,
     // The layer's tables in `rtw_tables`: u offset, u texels, v offset, v texels.
     tables: vec4<u32>,
     // RTW rule: pieces per unit of base u and v, error scale; w: the paraboloid side
-    // (0 front, 1 back).
+    // (0 front, 1 back), or in the window mode the near plane's `w` of the base.
     rule: vec4<f32>,
 }
 
 struct RefineParams {
-    // The base of the matrix mode.
-    uv_from_world: mat4x4<f32>,
     // The base of the paraboloid mode (side = layer).
     paraboloid: Paraboloid,
     // Grid rule: texels per side, tolerance in texels, most segments per edge; w: unused.
     grid: vec4<f32>,
-    // x: mode (bit 0: paraboloid base, bit 1: grid rule), y: levels, z: casters,
-    // w: layers.
+    // x: mode (bit 0: paraboloid base, bit 1: grid rule, bit 2: casters cut to each
+    // layer's window), y: levels, z: casters, w: layers.
     sizes: vec4<u32>,
     // x: capacity in triangles; y, z, w: unused.
     limits: vec4<u32>,
-    layers: array<RefineLayer, 2>,
+    layers: array<RefineLayer, 6>,
 }
 
 // Deepest refinement (RTW: `max_segments` 1024; grid: 2^8 = 256 segments) and the
-// stack depth the RTW recursion needs (the two pieces of a cut, then each level pops
-// one node and pushes up to four: 2 + 3 * MAX_LEVELS).
+// stack depth the RTW recursion needs (the fan of a clipped caster, at most
+// MAX_POLYGON - 2 pieces, then each level pops one node and pushes up to four:
+// 6 + 3 * MAX_LEVELS).
 const MAX_LEVELS: u32 = 10u;
-const STACK: u32 = 32u;
+const STACK: u32 = 36u;
 const CAPS: u32 = 11u;
-const MAX_LAYERS: u32 = 2u;
+const MAX_LAYERS: u32 = 6u;
 // Words of `state`: lo/hi totals per layer and cap (2 * MAX_LAYERS * CAPS), then these.
-const APPEND: u32 = 44u;
-const CHOSEN: u32 = 46u;
-const DRAWN: u32 = 47u;
-const OVERFLOW: u32 = 49u;
+const APPEND: u32 = 132u;
+const CHOSEN: u32 = 138u;
+const DRAWN: u32 = 139u;
+const OVERFLOW: u32 = 145u;
 const MODE_PARABOLOID: u32 = 1u;
 const MODE_GRID: u32 = 2u;
+const MODE_WINDOW: u32 = 4u;
+// Most vertices of a caster clipped by the planes (each adds at most one).
+const MAX_POLYGON: u32 = 8u;
 // Where the grid rule measures a segment's deviation from its chord
 // (`shadowmap_paraboloid::DEVIATION_SAMPLES`).
 const DEVIATION_SAMPLES = array<f32, 3>(0.25, 0.5, 0.75);
@@ -103,12 +113,12 @@ const DEVIATION_SAMPLES = array<f32, 3>(0.25, 0.5, 0.75);
 @group(0) @binding(1) var<storage, read> rtw_tables: array<f32>;
 // The casters: 9 floats per triangle.
 @group(0) @binding(2) var<storage, read> casters: array<f32>;
-@group(0) @binding(3) var<storage, read_write> state: array<atomic<u32>, 64>;
+@group(0) @binding(3) var<storage, read_write> state: array<atomic<u32>, 146>;
 // Pieces per (layer, caster) at every cap (CAPS words each).
 @group(0) @binding(4) var<storage, read_write> piece_counts: array<u32>;
 @group(0) @binding(5) var<storage, read_write> refined: array<f32>;
 // Per layer: vertex_count, instance_count, first_vertex, first_instance.
-@group(0) @binding(6) var<storage, read_write> draw: array<u32, 8>;
+@group(0) @binding(6) var<storage, read_write> draw: array<u32, 24>;
 
 // @compose rtw_sample begin
 // Placeholder: the sampler of rtw_sample.wgsl is composed in here.
@@ -163,7 +173,7 @@ fn base_uv(p: vec3<f32>, layer: u32) -> Mapped {
     if (params.sizes.x & MODE_PARABOLOID) != 0u {
         return paraboloid_uv(light_point(p), layer);
     }
-    let h = params.uv_from_world * vec4<f32>(p, 1.0);
+    let h = params.layers[layer].uv_from_world * vec4<f32>(p, 1.0);
     let uv = h.xy / h.w;
     return Mapped(uv, h.w > 0.0 && finite2(uv));
 }
@@ -209,19 +219,50 @@ fn mappable(t: Tri, layer: u32) -> bool {
     return finite && base_uv(t.a, layer).ok && base_uv(t.b, layer).ok && base_uv(t.c, layer).ok;
 }
 
-// RTW: the parts of a caster in front of the plane of the layer's side (paraboloid
-// base; `ParaboloidMap::plane_distance`), as `subdivide_for_rtw_clipped` cuts them:
-// the caster itself, nothing, or one or two triangles (same winding) with the
-// crossing points of its edges, each interpolated from the edge's end in front. A
-// matrix base is not cut. A caster with a non-finite vertex gives nothing.
-struct Cut {
-    pieces: array<Tri, 2>,
-    count: u32,
+// RTW: the part of a caster in front of the planes that bound the layer's base, as
+// `subdivide_for_rtw_clipped` clips it: a paraboloid side's plane
+// (`ParaboloidMap::plane_distance`), or a window's five (`w - near`, then the sides
+// `u w >= 0`, `u w <= w`, `v w <= w`, `v w >= 0`, in the CPU's order of its clip
+// planes `w + x`, `w - x`, `w + y`, `w - y`); a matrix base without a window is not
+// clipped. The result is a convex polygon (Sutherland-Hodgman, each crossing
+// interpolated from its edge's end in front) whose pieces are its fan from its first
+// vertex. A caster with a non-finite vertex gives nothing.
+struct Polygon {
+    v: array<vec3<f32>, MAX_POLYGON>,
+    n: u32,
 }
 
-fn plane_distance(p: vec3<f32>, layer: u32) -> f32 {
-    let z = light_point(p).z;
-    return select(-z, z, params.layers[layer].rule.w > 0.5);
+fn plane_count() -> u32 {
+    if (params.sizes.x & MODE_PARABOLOID) != 0u {
+        return 1u;
+    }
+    return select(0u, 5u, (params.sizes.x & MODE_WINDOW) != 0u);
+}
+
+fn plane_distance(p: vec3<f32>, layer: u32, plane: u32) -> f32 {
+    let rule = params.layers[layer].rule;
+    if (params.sizes.x & MODE_PARABOLOID) != 0u {
+        let z = light_point(p).z;
+        return select(-z, z, rule.w > 0.5);
+    }
+    let h = params.layers[layer].uv_from_world * vec4<f32>(p, 1.0);
+    switch plane {
+        case 0u: {
+            return h.w - rule.w;
+        }
+        case 1u: {
+            return h.x;
+        }
+        case 2u: {
+            return h.w - h.x;
+        }
+        case 3u: {
+            return h.w - h.y;
+        }
+        default: {
+            return h.y;
+        }
+    }
 }
 
 // The point where edge `a b` crosses the plane, interpolated from `a` (in front).
@@ -229,46 +270,50 @@ fn crossing(a: vec3<f32>, b: vec3<f32>, da: f32, db: f32) -> vec3<f32> {
     return a + (b - a) * (da / (da - db));
 }
 
-fn cut_at_side(t: Tri, layer: u32) -> Cut {
-    var cut: Cut;
-    let finite = finite3(t.a) && finite3(t.b) && finite3(t.c);
-    var d = vec3<f32>(1.0);
-    if finite && (params.sizes.x & MODE_PARABOLOID) != 0u {
-        d = vec3<f32>(plane_distance(t.a, layer), plane_distance(t.b, layer), plane_distance(t.c, layer));
+// One Sutherland-Hodgman step: the part of `poly` in front of one plane, walking its
+// edges in order and keeping the vertices in front and the crossings.
+fn clip_polygon(poly: Polygon, layer: u32, plane: u32) -> Polygon {
+    var d: array<f32, MAX_POLYGON>;
+    for (var i = 0u; i < poly.n; i++) {
+        d[i] = plane_distance(poly.v[i], layer, plane);
     }
-    let front = d >= vec3<f32>(0.0);
-    let n = select(0u, u32(front.x) + u32(front.y) + u32(front.z), finite);
-    // The crossings of the three edges (where they cross), each from its end in
-    // front, and the part in front in the CPU's order: the vertices and crossings
-    // met walking a, b, c (one triangle, or a quad cut along its first vertex's
-    // diagonal).
-    let ab = select(crossing(t.b, t.a, d.y, d.x), crossing(t.a, t.b, d.x, d.y), front.x);
-    let bc = select(crossing(t.c, t.b, d.z, d.y), crossing(t.b, t.c, d.y, d.z), front.y);
-    let ca = select(crossing(t.a, t.c, d.x, d.z), crossing(t.c, t.a, d.z, d.x), front.z);
-    if n == 3u {
-        cut.pieces[0] = t;
-        cut.count = 1u;
-    } else if n == 1u {
-        cut.count = 1u;
-        if front.x {
-            cut.pieces[0] = Tri(t.a, ab, ca, 0u);
-        } else if front.y {
-            cut.pieces[0] = Tri(ab, t.b, bc, 0u);
-        } else {
-            cut.pieces[0] = Tri(bc, t.c, ca, 0u);
+    var out: Polygon;
+    out.n = 0u;
+    for (var i = 0u; i < poly.n; i++) {
+        let j = select(i + 1u, 0u, i + 1u == poly.n);
+        let front_i = d[i] >= 0.0;
+        let front_j = d[j] >= 0.0;
+        if front_i && out.n < MAX_POLYGON {
+            out.v[out.n] = poly.v[i];
+            out.n += 1u;
         }
-    } else if n == 2u {
-        cut.count = 2u;
-        var quad = array<vec3<f32>, 4>(t.a, t.b, bc, ca);
-        if !front.x {
-            quad = array<vec3<f32>, 4>(ab, t.b, t.c, ca);
-        } else if !front.y {
-            quad = array<vec3<f32>, 4>(t.a, ab, bc, t.c);
+        if front_i != front_j && out.n < MAX_POLYGON {
+            if front_i {
+                out.v[out.n] = crossing(poly.v[i], poly.v[j], d[i], d[j]);
+            } else {
+                out.v[out.n] = crossing(poly.v[j], poly.v[i], d[j], d[i]);
+            }
+            out.n += 1u;
         }
-        cut.pieces[0] = Tri(quad[0], quad[1], quad[2], 0u);
-        cut.pieces[1] = Tri(quad[0], quad[2], quad[3], 0u);
     }
-    return cut;
+    return out;
+}
+
+fn clip_to_base(t: Tri, layer: u32) -> Polygon {
+    var poly: Polygon;
+    poly.n = 0u;
+    if !(finite3(t.a) && finite3(t.b) && finite3(t.c)) {
+        return poly;
+    }
+    poly.v[0] = t.a;
+    poly.v[1] = t.b;
+    poly.v[2] = t.c;
+    poly.n = 3u;
+    let planes = plane_count();
+    for (var plane = 0u; plane < planes; plane++) {
+        poly = clip_polygon(poly, layer, plane);
+    }
+    return poly;
 }
 
 // The pieces of one RTW step of `t`, rotated so the halved edges come first (the
@@ -430,12 +475,12 @@ fn levels() -> u32 {
 // Marks a walk that counts instead of writing.
 const COUNT_ONLY: u32 = 0xffffffffu;
 
-// RTW: walks the refinement of the mappable pieces of `cut` down to `limit`
-// halvings. With `first` = COUNT_ONLY it counts the pieces at every cap up to
+// RTW: walks the refinement of the mappable pieces of `poly` (its fan) down to
+// `limit` halvings. With `first` = COUNT_ONLY it counts the pieces at every cap up to
 // `limit` (a piece that would be halved at depth d is one piece at cap d, a leaf one
 // piece at every cap from its depth on); otherwise it writes the leaves from slot
-// `first` on. Both pieces of a cut start on the stack, so one walk serves them.
-fn rtw_walk(cut: Cut, layer: u32, limit: u32, first: u32) -> array<u32, CAPS> {
+// `first` on. Every piece of the fan starts on the stack, so one walk serves them.
+fn rtw_walk(poly: Polygon, layer: u32, limit: u32, first: u32) -> array<u32, CAPS> {
     // Counting: leaves and halved nodes per depth, summed into caps at the end, so
     // every node costs one iteration (software rasterizers bound a loop's iterations:
     // llvmpipe stops a loop after 65535).
@@ -444,13 +489,12 @@ fn rtw_walk(cut: Cut, layer: u32, limit: u32, first: u32) -> array<u32, CAPS> {
     var slot = first;
     var stack: array<Tri, STACK>;
     var top = 0u;
-    if cut.count > 0u && mappable(cut.pieces[0], layer) {
-        stack[0] = cut.pieces[0];
-        top = 1u;
-    }
-    if cut.count > 1u && mappable(cut.pieces[1], layer) {
-        stack[top] = cut.pieces[1];
-        top += 1u;
+    for (var k = 1u; k + 1u < poly.n; k++) {
+        let piece = Tri(poly.v[0], poly.v[k], poly.v[k + 1u], 0u);
+        if mappable(piece, layer) {
+            stack[top] = piece;
+            top += 1u;
+        }
     }
     while top > 0u {
         top -= 1u;
@@ -473,10 +517,17 @@ fn rtw_walk(cut: Cut, layer: u32, limit: u32, first: u32) -> array<u32, CAPS> {
         if first == COUNT_ONLY {
             halved[t.depth] += 1u;
         }
-        for (var k = 0u; k < s.count; k++) {
-            stack[top] = s.pieces[k];
-            top += 1u;
+        // Pushed without an inner loop: llvmpipe's loop bound counts the
+        // iterations of nested loops together with the walk's own.
+        stack[top] = s.pieces[0];
+        stack[top + 1u] = s.pieces[1];
+        if s.count > 2u {
+            stack[top + 2u] = s.pieces[2];
         }
+        if s.count > 3u {
+            stack[top + 3u] = s.pieces[3];
+        }
+        top += s.count;
     }
     var counts: array<u32, CAPS>;
     var below = 0u;
@@ -504,7 +555,7 @@ fn count(@builtin(global_invocation_id) id: vec3<u32>) {
             counts[c] = m * m;
         }
     } else {
-        counts = rtw_walk(cut_at_side(root, layer), layer, top_level, COUNT_ONLY);
+        counts = rtw_walk(clip_to_base(root, layer), layer, top_level, COUNT_ONLY);
     }
     let at = CAPS * (layer * params.sizes.z + i);
     for (var c = 0u; c <= top_level; c++) {
@@ -608,6 +659,6 @@ fn emit(@builtin(global_invocation_id) id: vec3<u32>) {
         // pieces = m^2 with m <= 256: the square root is exact after rounding.
         emit_grid(root, u32(round(sqrt(f32(pieces)))), slot);
     } else {
-        rtw_walk(cut_at_side(root, layer), layer, cap, slot);
+        rtw_walk(clip_to_base(root, layer), layer, cap, slot);
     }
 }

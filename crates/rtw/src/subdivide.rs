@@ -213,14 +213,15 @@ pub type ClipPlane<'a> = &'a dyn Fn(Vec3) -> f64;
 /// inside its window's frustum). `planes` (the first [`MAX_CLIP_PLANES`]) bound that
 /// region ([`ClipPlane`]).
 ///
-/// Triangles wholly behind a plane are left out; triangles across one are cut at it
-/// first (their part in front, one or two triangles per plane), then split. Behind
-/// a paraboloid side the base coordinates run off toward the pole, behind a
-/// perspective base they do not exist, and beside a perspective window they only
-/// cost pieces the depth pass clips: the split rule would spend levels of every edge
-/// on geometry the depth pass discards, or leave a caster unsplit. An edge is cut at
-/// the point interpolated from its end in front, so two triangles sharing it cut it
-/// alike (no cracks).
+/// Triangles wholly behind a plane are left out; triangles across one are clipped
+/// first (their part in front of every plane, a convex polygon of at most
+/// `3 + planes` vertices, as the fan of triangles from its first vertex), then
+/// split. Behind a paraboloid side the base coordinates run off toward the pole,
+/// behind a perspective base they do not exist, and beside a perspective window they
+/// only cost pieces the depth pass clips: the split rule would spend levels of every
+/// edge on geometry the depth pass discards, or leave a caster unsplit. An edge is
+/// cut at the point interpolated from its end in front, so two triangles sharing it
+/// cut it alike (no cracks).
 pub fn subdivide_for_rtw_clipped(
     base_uv: impl Fn(Vec3) -> Option<DVec2>,
     planes: &[ClipPlane<'_>],
@@ -252,65 +253,53 @@ pub fn subdivide_for_rtw_clipped(
     out.len()
 }
 
-/// Most pieces of a triangle cut by [`MAX_CLIP_PLANES`] planes (each cut at most
-/// doubles them).
-const MAX_CUT_PIECES: usize = 1 << MAX_CLIP_PLANES;
+/// Most vertices of a triangle clipped by [`MAX_CLIP_PLANES`] planes (each plane
+/// adds at most one to a convex polygon).
+const MAX_CLIPPED_VERTICES: usize = 3 + MAX_CLIP_PLANES;
 
-/// The part of a triangle in front of every plane, as triangles (same winding).
-fn cut_at_planes(t: [Vec3; 3], planes: &[ClipPlane<'_>]) -> ArrayVec<[Vec3; 3], MAX_CUT_PIECES> {
-    let mut pieces = ArrayVec::new();
-    pieces.push(t);
+/// The part of a triangle in front of every plane, as the fan of its clipped
+/// polygon from the polygon's first vertex (same winding; nothing when no part is
+/// in front).
+fn cut_at_planes(
+    t: [Vec3; 3],
+    planes: &[ClipPlane<'_>],
+) -> impl Iterator<Item = [Vec3; 3]> + use<> {
+    let mut polygon: ArrayVec<Vec3, MAX_CLIPPED_VERTICES> = t.into_iter().collect();
     for plane in planes {
-        let mut next = ArrayVec::new();
-        for piece in &pieces {
-            for cut in cut_at_plane(*piece, *plane).into_iter().flatten() {
-                let _ = next.try_push(cut);
-            }
-        }
-        pieces = next;
+        polygon = clip_polygon(&polygon, *plane);
     }
-    pieces
+    let first = polygon.first().copied().unwrap_or(Vec3::ZERO);
+    (1..polygon.len().saturating_sub(1)).map(move |k| [first, polygon[k], polygon[k + 1]])
 }
 
-/// The part of a triangle in front of the plane where `distance >= 0`: the triangle
-/// itself, nothing, or one or two triangles (same winding) with the crossing points
-/// of its edges, each interpolated from the edge's end in front.
-fn cut_at_plane(t: [Vec3; 3], distance: ClipPlane<'_>) -> [Option<[Vec3; 3]>; 2] {
-    let d = t.map(distance);
-    let front = d.map(|x| x >= 0.0);
-    match front.iter().filter(|f| **f).count() {
-        3 => return [Some(t), None],
-        0 => return [None, None],
-        _ => {}
-    }
-    // Walk the edges, keeping the vertices in front and the crossings.
-    let mut poly = [Vec3::ZERO; 4];
-    let mut n = 0;
-    for i in 0..3 {
-        let j = (i + 1) % 3;
-        if front[i] {
-            poly[n] = t[i];
-            n += 1;
+/// One Sutherland-Hodgman step: the part of a convex polygon in front of the plane
+/// where `distance >= 0`, walking its edges in order and keeping the vertices in
+/// front and the crossings, each interpolated from the edge's end in front (so two
+/// triangles sharing an edge cut it at the same point). For a triangle this is the
+/// triangle itself, nothing, or the triangle or quad whose fan is one or two
+/// triangles.
+fn clip_polygon(polygon: &[Vec3], distance: ClipPlane<'_>) -> ArrayVec<Vec3, MAX_CLIPPED_VERTICES> {
+    let mut out = ArrayVec::new();
+    let n = polygon.len();
+    let mut d: ArrayVec<f64, MAX_CLIPPED_VERTICES> = ArrayVec::new();
+    d.extend(polygon.iter().map(|p| distance(*p)));
+    for i in 0..n {
+        let j = (i + 1) % n;
+        let (front_i, front_j) = (d[i] >= 0.0, d[j] >= 0.0);
+        if front_i {
+            let _ = out.try_push(polygon[i]);
         }
-        if front[i] != front[j] {
-            let (a, b, da, db) = if front[i] {
-                (t[i], t[j], d[i], d[j])
+        if front_i != front_j {
+            let (a, b, da, db) = if front_i {
+                (polygon[i], polygon[j], d[i], d[j])
             } else {
-                (t[j], t[i], d[j], d[i])
+                (polygon[j], polygon[i], d[j], d[i])
             };
             let s = da / (da - db);
-            poly[n] = (a.as_dvec3() + (b.as_dvec3() - a.as_dvec3()) * s).as_vec3();
-            n += 1;
+            let _ = out.try_push((a.as_dvec3() + (b.as_dvec3() - a.as_dvec3()) * s).as_vec3());
         }
     }
-    match n {
-        3 => [Some([poly[0], poly[1], poly[2]]), None],
-        4 => [
-            Some([poly[0], poly[1], poly[2]]),
-            Some([poly[0], poly[2], poly[3]]),
-        ],
-        _ => [None, None],
-    }
+    out
 }
 
 /// The per-edge split rule of [`subdivide_for_rtw`].
@@ -560,6 +549,64 @@ mod tests {
             halves += clipped.iter().map(area).sum::<f32>();
         }
         assert!((halves - area(&across)).abs() < 1e-5, "{halves}");
+    }
+
+    /// A triangle across a window's four sides is clipped once to the window, not
+    /// cut plane by plane: its pieces are the fan of the clipped polygon (at most
+    /// seven vertices here, so at most five triangles), all inside the window,
+    /// same winding, covering exactly the triangle's part inside it.
+    #[test]
+    fn a_triangle_across_a_window_is_the_fan_of_its_clipped_polygon() {
+        let warps = warps();
+        let shadow = shadow(&warps);
+        let base = |p: Vec3| shadow.base.project(p).map(|s| s.uv);
+        let sides: [&dyn Fn(Vec3) -> f64; 4] = [
+            &|p| f64::from(p.x) - 0.2,
+            &|p| 0.8 - f64::from(p.x),
+            &|p| f64::from(p.y) - 0.2,
+            &|p| 0.8 - f64::from(p.y),
+        ];
+        let across = [
+            Vec3::new(0.5, -0.3, 0.5),
+            Vec3::new(1.3, 0.6, 0.5),
+            Vec3::new(-0.2, 1.0, 0.5),
+        ];
+        // Coarse enough that nothing splits: the pieces are the fan itself.
+        let options = RtwSubdivision::default()
+            .with_max_span_cells(64.0)
+            .with_max_error_texels(64.0)
+            .with_max_segments(1);
+        let mut pieces = Vec::new();
+        subdivide_for_rtw_clipped(base, &sides, &warps, &[across], &options, &mut pieces);
+        assert!((3..=5).contains(&pieces.len()), "{} pieces", pieces.len());
+        assert!(
+            pieces
+                .iter()
+                .flatten()
+                .all(|p| sides.iter().all(|d| d(*p) >= -1e-6))
+        );
+        let normal = |t: &[Vec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]).z;
+        assert!(pieces.iter().all(|t| normal(t) >= 0.0) && normal(&across) > 0.0);
+        // The window's corners (0.2, 0.2) and (0.8, 0.2) lie outside the triangle,
+        // the rest of the square inside: compare with a grid count of the part.
+        let inside = |x: f32, y: f32| {
+            let p = Vec3::new(x, y, 0.5);
+            let edge = |a: Vec3, b: Vec3| (b - a).cross(p - a).z >= 0.0;
+            edge(across[0], across[1]) && edge(across[1], across[2]) && edge(across[2], across[0])
+        };
+        let n = 400;
+        let cell = 0.6 / n as f32;
+        let hits = (0..n * n)
+            .filter(|k| {
+                inside(
+                    0.2 + (k % n) as f32 * cell + cell / 2.0,
+                    0.2 + (k / n) as f32 * cell + cell / 2.0,
+                )
+            })
+            .count();
+        let expected = hits as f32 * cell * cell;
+        let covered = pieces.iter().map(area).sum::<f32>();
+        assert!((covered - expected).abs() < 2e-3, "{covered} vs {expected}");
     }
 
     #[test]

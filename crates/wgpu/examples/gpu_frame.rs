@@ -332,11 +332,15 @@ fn json(adapter: &str, profiler: &GpuProfiler, rows: &[Row]) -> String {
     )
 }
 
-/// Every technique of the umbrella crate, plus RTW over the spot fit and over the
-/// IPSM paraboloid.
+/// Every technique of the umbrella crate, plus RTW over the spot fit, over the cube
+/// faces and over the IPSM paraboloid.
 fn techniques() -> Vec<Technique> {
     let mut all = Technique::all_default().to_vec();
     all.push(Technique::SpotRtw(RtwPlan::default()));
+    all.push(Technique::CubeRtw {
+        cube: Default::default(),
+        rtw: RtwPlan::default(),
+    });
     all.push(Technique::PointRtw {
         ipsm: Default::default(),
         rtw: RtwPlan::default(),

@@ -37,15 +37,14 @@
 
 use std::num::NonZeroU64;
 
-use glam::Vec3;
-use wgpu::util::DeviceExt;
-
 use crate::uniforms::{MatrixShadowRaw, ParaboloidLayerRaw, RtwShadowRaw};
 use crate::{BackendError, GpuContext, compose, shaders};
 
 /// The caster subdivision of RTW's depth pass lives beside the warp tables in
 /// `shadowmap-rtw` (one algorithm for the CPU reference and this backend).
 pub use shadowmap_rtw::{RtwSubdivision, subdivide_for_rtw};
+
+pub use crate::mesh::MeshBuffers;
 
 /// The depth format of every shadow map.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -158,6 +157,16 @@ pub enum DepthUniforms<'a> {
         /// A buffer with `COPY_SRC` usage holding at least `sizes.x + sizes.y` `f32`.
         tables: &'a wgpu::Buffer,
     },
+    /// RTW over the kept faces of a cube map ([`crate::uniforms::warped_cube`]): one
+    /// block per face (its perspective base, where its tables start in `tables`,
+    /// its layer's corner and near plane), one layer each. Refined casters are cut
+    /// to each face's window frustum first.
+    WarpedCube {
+        /// One block per kept face, at most [`crate::refine::MAX_LAYERS`].
+        layers: &'a [RtwShadowRaw],
+        /// Every face's tables.
+        tables: &'a [f32],
+    },
 }
 
 impl DepthUniforms<'_> {
@@ -165,8 +174,41 @@ impl DepthUniforms<'_> {
         match self {
             Self::Matrix(_) => DepthTechnique::Matrix,
             Self::Paraboloid(_) | Self::WarpedParaboloid { .. } => DepthTechnique::Paraboloid,
-            Self::Rtw { .. } | Self::RtwGpuTables { .. } => DepthTechnique::Rtw,
+            Self::Rtw { .. } | Self::RtwGpuTables { .. } | Self::WarpedCube { .. } => {
+                DepthTechnique::Rtw
+            }
         }
+    }
+
+    /// The warp tables given as a slice (RTW, cube faces, paraboloid sides), checked
+    /// against the offsets and sizes the blocks read; `None` for the techniques
+    /// without tables or with tables in a GPU buffer.
+    ///
+    /// # Errors
+    /// [`BackendError::InvalidInput`] for tables shorter than a block reads.
+    pub(crate) fn cpu_tables(&self) -> Result<Option<&[f32]>, BackendError> {
+        let (tables, needed) = match self {
+            Self::Rtw { raw, tables } => (*tables, rtw_table_texels(raw)),
+            Self::WarpedCube { layers, tables } => (
+                *tables,
+                layers.iter().map(rtw_table_texels).max().unwrap_or(0),
+            ),
+            Self::WarpedParaboloid { layers, tables } => (
+                *tables,
+                layers
+                    .iter()
+                    .map(|l| warp_table_end(&l.warp))
+                    .max()
+                    .unwrap_or(0),
+            ),
+            Self::Matrix(_) | Self::Paraboloid(_) | Self::RtwGpuTables { .. } => return Ok(None),
+        };
+        if tables.len() < needed.max(1) {
+            return Err(BackendError::InvalidInput(
+                "warp tables shorter than their blocks' offsets and sizes",
+            ));
+        }
+        Ok(Some(tables))
     }
 
     fn layer_count(&self) -> usize {
@@ -174,6 +216,7 @@ impl DepthUniforms<'_> {
             Self::Matrix(m) => m.len(),
             Self::Paraboloid(p) | Self::WarpedParaboloid { layers: p, .. } => p.len(),
             Self::Rtw { .. } | Self::RtwGpuTables { .. } => 1,
+            Self::WarpedCube { layers, .. } => layers.len(),
         }
     }
 
@@ -192,97 +235,11 @@ impl DepthUniforms<'_> {
                 raw.sizes[3] = resolution;
                 bytemuck::bytes_of(&raw).to_vec()
             }
-        }
-    }
-}
-
-/// Positions (`vec3<f32>`, location 0) and `u32` indices on the GPU.
-#[derive(Debug)]
-pub struct MeshBuffers {
-    /// Vertex positions.
-    pub vertices: wgpu::Buffer,
-    /// Triangle-list indices.
-    pub indices: wgpu::Buffer,
-    /// Number of indices.
-    pub index_count: u32,
-}
-
-impl MeshBuffers {
-    /// Uploads an indexed triangle mesh.
-    ///
-    /// # Errors
-    /// [`BackendError::InvalidInput`] for an empty mesh, an index out of range, a
-    /// non-finite position, or a mesh past the device's largest buffer.
-    pub fn new(
-        ctx: &GpuContext,
-        positions: &[Vec3],
-        triangles: &[[u32; 3]],
-    ) -> Result<Self, BackendError> {
-        if positions.is_empty() || triangles.is_empty() {
-            return Err(BackendError::InvalidInput("empty mesh"));
-        }
-        if !positions.iter().all(|p| p.is_finite()) {
-            return Err(BackendError::InvalidInput("non-finite vertex position"));
-        }
-        let n = positions.len();
-        if triangles.iter().flatten().any(|&i| i as usize >= n) {
-            return Err(BackendError::InvalidInput("vertex index out of range"));
-        }
-        let index_count = u32::try_from(triangles.len() * 3)
-            .map_err(|_| BackendError::InvalidInput("too many triangles"))?;
-        // wgpu panics (not an error scope) on a buffer past the device's limit.
-        let max = ctx.device.limits().max_buffer_size;
-        if (positions.len() as u64).saturating_mul(12) > max
-            || u64::from(index_count).saturating_mul(4) > max
-        {
-            return Err(BackendError::InvalidInput(
-                "mesh larger than the device's largest buffer",
-            ));
-        }
-        let vertices = ctx
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("shadowmap mesh vertices"),
-                contents: bytemuck::cast_slice(positions),
-                usage: wgpu::BufferUsages::VERTEX,
-            });
-        let indices = ctx
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("shadowmap mesh indices"),
-                contents: bytemuck::cast_slice(triangles),
-                usage: wgpu::BufferUsages::INDEX,
-            });
-        Ok(Self {
-            vertices,
-            indices,
-            index_count,
-        })
-    }
-
-    /// Uploads a triangle soup (three vertices per triangle, no sharing).
-    ///
-    /// # Errors
-    /// As [`MeshBuffers::new`].
-    pub fn from_triangles(ctx: &GpuContext, triangles: &[[Vec3; 3]]) -> Result<Self, BackendError> {
-        let positions: Vec<Vec3> = triangles.iter().flatten().copied().collect();
-        let indices: Vec<[u32; 3]> = (0..triangles.len() as u32)
-            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-            .collect();
-        Self::new(ctx, &positions, &indices)
-    }
-
-    /// The vertex layout: one `vec3<f32>` at location 0.
-    #[must_use]
-    pub const fn layout() -> wgpu::VertexBufferLayout<'static> {
-        wgpu::VertexBufferLayout {
-            array_stride: 12,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &[wgpu::VertexAttribute {
-                format: wgpu::VertexFormat::Float32x3,
-                offset: 0,
-                shader_location: 0,
-            }],
+            Self::WarpedCube { layers, .. } => {
+                let mut raw = layers[layer];
+                raw.sizes[3] = resolution;
+                bytemuck::bytes_of(&raw).to_vec()
+            }
         }
     }
 }
@@ -311,7 +268,8 @@ impl ShadowDepthPass {
     ///
     /// # Errors
     /// [`BackendError::InvalidInput`] for a resolution or layer count of 0 or above the
-    /// device's limits, or more than one layer for RTW;
+    /// device's limits, or more RTW layers than one refinement feeds
+    /// ([`crate::refine::MAX_LAYERS`]);
     /// [`BackendError::Wgpu`] if wgpu rejects a resource.
     pub fn new(ctx: &GpuContext, desc: &DepthPassDesc) -> Result<Self, BackendError> {
         let limits = ctx.device.limits();
@@ -323,8 +281,10 @@ impl ShadowDepthPass {
         if desc.layers == 0 || desc.layers > limits.max_texture_array_layers {
             return Err(BackendError::InvalidInput("layer count out of range"));
         }
-        if desc.technique == DepthTechnique::Rtw && desc.layers != 1 {
-            return Err(BackendError::InvalidInput("RTW renders one layer"));
+        if desc.technique == DepthTechnique::Rtw && desc.layers > crate::refine::MAX_LAYERS {
+            return Err(BackendError::InvalidInput(
+                "RTW renders at most one layer per cube face",
+            ));
         }
         if !(desc.bias.slope_scale.is_finite() && desc.bias.clamp.is_finite()) {
             return Err(BackendError::InvalidInput("non-finite depth bias"));
@@ -524,17 +484,6 @@ impl ShadowDepthPass {
             ));
         }
         match uniforms {
-            DepthUniforms::Rtw { raw, tables } => {
-                let needed = rtw_table_texels(raw);
-                if tables.len() < needed.max(1) {
-                    return Err(BackendError::InvalidInput(
-                        "RTW tables shorter than their sizes",
-                    ));
-                }
-                let bytes: &[u8] = bytemuck::cast_slice(tables);
-                let buffer = self.rtw_table_buffer(ctx, bytes.len() as u64);
-                ctx.queue.write_buffer(buffer, 0, bytes);
-            }
             DepthUniforms::RtwGpuTables { raw, tables } => {
                 let bytes = (rtw_table_texels(raw).max(1) * 4) as u64;
                 if tables.size() < bytes {
@@ -550,22 +499,13 @@ impl ShadowDepthPass {
                 let buffer = self.rtw_table_buffer(ctx, bytes);
                 encoder.copy_buffer_to_buffer(tables, 0, buffer, 0, bytes);
             }
-            DepthUniforms::WarpedParaboloid { layers, tables } => {
-                let needed = layers
-                    .iter()
-                    .map(|l| warp_table_end(&l.warp))
-                    .max()
-                    .unwrap_or(0);
-                if tables.len() < needed.max(1) {
-                    return Err(BackendError::InvalidInput(
-                        "paraboloid warp tables shorter than their layers' offsets",
-                    ));
+            _ => {
+                if let Some(tables) = uniforms.cpu_tables()? {
+                    let bytes: &[u8] = bytemuck::cast_slice(tables);
+                    let buffer = self.rtw_table_buffer(ctx, bytes.len() as u64);
+                    ctx.queue.write_buffer(buffer, 0, bytes);
                 }
-                let bytes: &[u8] = bytemuck::cast_slice(tables);
-                let buffer = self.rtw_table_buffer(ctx, bytes.len() as u64);
-                ctx.queue.write_buffer(buffer, 0, bytes);
             }
-            DepthUniforms::Matrix(_) | DepthUniforms::Paraboloid(_) => {}
         }
         for layer in 0..layers {
             ctx.queue.write_buffer(
@@ -647,9 +587,15 @@ impl ShadowDepthPass {
     }
 }
 
-/// Texels of both RTW tables a block declares.
+/// One past the last table texel an RTW block reads (its `u` and `v` tables at
+/// their offsets).
 pub(crate) fn rtw_table_texels(raw: &RtwShadowRaw) -> usize {
-    (raw.sizes[0] as usize).saturating_add(raw.sizes[1] as usize)
+    warp_table_end(&[
+        raw.table_offsets[0],
+        raw.sizes[0],
+        raw.table_offsets[1],
+        raw.sizes[1],
+    ])
 }
 
 /// One past the last texel a paraboloid side's warp (`u` offset, `u` texels, `v`

@@ -13,7 +13,7 @@
 //! | [`context`] | [`GpuContext`]: headless device, error scopes ([`GpuContext::scoped`]), readback ([`GpuContext::read_buffer`], [`GpuContext::read_texture`]), test gating |
 //! | [`compose`] | WGSL composition: lookups and filters into the scene shader, the RTW table sampler into its depth pass and lookup |
 //! | [`uniforms`] | `#[repr(C)]` blocks built by [`uniforms::ToRaw`] |
-//! | [`depth`] | [`depth::ShadowDepthPass`]: matrix / paraboloid / RTW depth passes (RTW over an orthographic or perspective base, paraboloid sides optionally warped) |
+//! | [`depth`] | [`depth::ShadowDepthPass`]: matrix / paraboloid / RTW depth passes (RTW over an orthographic or perspective base or each kept cube face, paraboloid sides optionally warped) |
 //! | [`render`] | [`render::HeadlessRenderer`]: scene pass with a lookup and a filter composed in, PNGs, shadow masks |
 //! | [`shadow`] | [`render::HeadlessRenderer::render_shadow`]: a fitted `shadowmap::Shadow` to the renderer, the one match from fitted result to lookup and depth pass |
 //! | [`profile`] | [`profile::GpuProfiler`]: GPU time per pass from timestamp queries |
@@ -146,7 +146,8 @@
 //! --example gpu_frame [-- --json]` renders the city block at 1920x1080 with a 2048²
 //! budget for every technique (uniform, cascades, LiSPSM, XPSM, TSM, RTW with CPU
 //! tables, `rtw_gpu` with its analysis on the GPU: G-buffer, importance, tables;
-//! spot, DPSM, IPSM, cube maps, RTW over the spot fit and over the paraboloid),
+//! spot, DPSM, IPSM, cube maps, RTW over the spot fit, the cube faces and the
+//! paraboloid),
 //! prints CPU ms and GPU ms per pass (CPU times only, and says so, without the
 //! timestamp features) and then the backend's three targets:
 //!
@@ -197,6 +198,7 @@ pub use context::{BackendError, GpuContext};
 
 // --- depth passes, uniforms, lookup, headless renderer (one author) ---
 pub mod depth;
+mod mesh;
 pub mod profile;
 pub mod render;
 pub mod shadow;
@@ -240,6 +242,10 @@ pub mod shaders {
     /// Lookup of RTW (base projection, warp tables); its table sampler is a
     /// placeholder until composed ([`crate::compose::lookup_rtw`]).
     pub const LOOKUP_RTW: &str = include_str!("../shaders/lookup_rtw.wgsl");
+    /// Lookup of RTW over the kept faces of a cube map (face by projection, its warp
+    /// tables, its layer's corner); its table sampler is a placeholder until composed
+    /// ([`crate::compose::lookup_cube_rtw`]).
+    pub const LOOKUP_CUBE_RTW: &str = include_str!("../shaders/lookup_cube_rtw.wgsl");
     /// The RTW warp-table sampler, composed into the RTW depth pass and lookup.
     pub const RTW_SAMPLE: &str = include_str!("../shaders/rtw_sample.wgsl");
     /// Filter: one nearest texel.

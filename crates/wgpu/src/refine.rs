@@ -4,9 +4,11 @@
 //! CPU reference:
 //!
 //! - **RTW** (Rosen, *Rectilinear Texture Warping for Fast Adaptive Shadow Mapping*,
-//!   I3D 2012), over a matrix base (the uniform or the spot fit) or over a paraboloid
-//!   side (`point_rtw`): [`shadowmap_rtw::subdivide_for_rtw_with`], its options clamped
-//!   by the same [`RtwSubdivision::split_rule`]. Edges are halved; an edge's decision
+//!   I3D 2012), over a matrix base (the uniform or the spot fit), over the kept faces
+//!   of a cube map (`cube_rtw`, casters cut to each face's window frustum first) or
+//!   over a paraboloid side (`point_rtw`, casters cut at the side's plane):
+//!   [`shadowmap_rtw::subdivide_for_rtw_clipped`], its options clamped by the same
+//!   [`RtwSubdivision::split_rule`]. Edges are halved; an edge's decision
 //!   depends on its two endpoints alone and is symmetric in them, so shared edges
 //!   split alike and a conforming mesh stays crack-free. Casters with a vertex the
 //!   base cannot map (behind a perspective light, at a paraboloid's light) are
@@ -56,34 +58,37 @@ use glam::Vec3;
 use shadowmap_paraboloid::{ParaboloidUniform, SubdivisionOptions};
 use shadowmap_rtw::RtwSubdivision;
 
-use crate::depth::{DepthUniforms, rtw_table_texels, table_buffer, warp_table_end};
-use crate::uniforms::ParaboloidLayerRaw;
+use crate::depth::{DepthUniforms, rtw_table_texels, table_buffer};
+use crate::uniforms::{ParaboloidLayerRaw, RtwShadowRaw};
 use crate::{BackendError, GpuContext, compose};
 
 /// Deepest refinement the pass supports: RTW's `max_segments` up to 1024, as
 /// [`RtwSubdivision`] allows (the grid needs at most 8: 256 segments).
 pub const MAX_LEVELS: u32 = 10;
-/// Layers one refinement feeds (the sides of a dual paraboloid).
-pub const MAX_LAYERS: u32 = 2;
+/// Layers one refinement feeds (the faces of a cube map; a dual paraboloid has two
+/// sides).
+pub const MAX_LAYERS: u32 = 6;
 /// Counts kept per caster and layer (one per cap `0..=MAX_LEVELS`).
 const CAPS: u64 = MAX_LEVELS as u64 + 1;
 /// Words of the state buffer (totals per layer and cap, cursors, stats); see the
 /// shader.
-const STATE_WORDS: u64 = 64;
+const STATE_WORDS: u64 = 146;
 /// Stats words in the state buffer: the chosen cap, then the pieces of each layer,
 /// then the overflow flag.
-const CHOSEN_WORD: usize = 46;
-const DRAWN_WORD: usize = 47;
-const OVERFLOW_WORD: usize = 49;
+const CHOSEN_WORD: usize = 138;
+const DRAWN_WORD: usize = 139;
+const OVERFLOW_WORD: usize = 145;
 /// Casters per workgroup of `count` and `emit`.
 const WORKGROUP: u32 = 64;
 /// Bytes of one refined (or original) triangle: three `vec3<f32>`.
 const TRIANGLE_BYTES: u64 = 36;
 /// Bytes of one layer's indirect draw arguments.
 const DRAW_BYTES: u64 = 16;
-/// Shader mode bits: the base is a paraboloid side; the grid rule.
+/// Shader mode bits: the base is a paraboloid side; the grid rule; casters cut to
+/// each layer's window frustum.
 const MODE_PARABOLOID: u32 = 1;
 const MODE_GRID: u32 = 2;
+const MODE_WINDOW: u32 = 4;
 
 /// Byte offset of `layer`'s draw arguments in [`GpuRefine::draw_buffer`].
 #[must_use]
@@ -167,9 +172,12 @@ pub struct RefineStats {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 struct RefineLayerRaw {
+    /// The layer's base in the matrix mode.
+    uv_from_world: [[f32; 4]; 4],
     /// Table offsets and texels: `u` offset, `u` texels, `v` offset, `v` texels.
     tables: [u32; 4],
-    /// Pieces per unit of base `u` and `v`, error scale; the paraboloid side.
+    /// Pieces per unit of base `u` and `v`, error scale; the paraboloid side, or the
+    /// window's near plane (`w` of the base).
     rule: [f32; 4],
 }
 
@@ -177,7 +185,6 @@ struct RefineLayerRaw {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 struct RefineParamsRaw {
-    uv_from_world: [[f32; 4]; 4],
     paraboloid: ParaboloidUniform,
     /// Grid rule: texels per side, tolerance, most segments; unused.
     grid: [f32; 4],
@@ -372,7 +379,8 @@ impl GpuRefine {
     /// Records one refinement for the technique of `uniforms`: RTW over a matrix base
     /// ([`DepthUniforms::Rtw`], [`DepthUniforms::RtwGpuTables`]; tables from a slice
     /// are queued, tables in a GPU buffer are copied inside `encoder`, so a build
-    /// recorded earlier in it is what the pass sees), RTW over paraboloid sides
+    /// recorded earlier in it is what the pass sees), RTW over cube faces
+    /// ([`DepthUniforms::WarpedCube`]), RTW over paraboloid sides
     /// ([`DepthUniforms::WarpedParaboloid`]) or the paraboloid grid
     /// ([`DepthUniforms::Paraboloid`]). The parameters go through
     /// `queue.write_buffer`: record at most one `encode` per submission.
@@ -416,19 +424,27 @@ impl GpuRefine {
         let mut params = RefineParamsRaw::zeroed();
         match uniforms {
             DepthUniforms::Rtw { raw, .. } | DepthUniforms::RtwGpuTables { raw, .. } => {
-                let [u, v, ..] = raw.sizes;
-                let rule = self.options.subdivision.split_rule(u as usize, v as usize);
-                params.uv_from_world = raw.uv_from_world;
-                params.sizes = [0, rule.levels, 0, 1];
-                params.layers[0] = RefineLayerRaw {
-                    tables: [0, u, u, v],
-                    rule: [
-                        rule.pieces.x as f32,
-                        rule.pieces.y as f32,
-                        rule.error_scale as f32,
-                        0.0,
-                    ],
-                };
+                let rule = self.rtw_layer(raw, &self.options.subdivision, 0.0);
+                params.sizes = [0, rule.1, 0, 1];
+                params.layers[0] = rule.0;
+            }
+            DepthUniforms::WarpedCube { layers, .. } => {
+                params.sizes = [MODE_WINDOW, 0, 0, checked_layers(layers.len())?];
+                for (slot, raw) in params.layers.iter_mut().zip(layers.iter()) {
+                    // As eval's reference: each face split for its own map side,
+                    // with enough pieces an edge to cross its whole window.
+                    let [u, v, ..] = raw.sizes;
+                    let side =
+                        raw.layer[0].max(raw.layer[1]) * self.options.subdivision.resolution as f32;
+                    let subdivision = self
+                        .options
+                        .subdivision
+                        .with_resolution(side.round().max(1.0) as u32)
+                        .with_segments_for_extent(1.0, u.max(v) as usize);
+                    let (layer, levels) = self.rtw_layer(raw, &subdivision, raw.layer[2]);
+                    *slot = layer;
+                    params.sizes[1] = params.sizes[1].max(levels);
+                }
             }
             DepthUniforms::Paraboloid(layers) => {
                 let rule = self
@@ -484,6 +500,30 @@ impl GpuRefine {
         Ok(params)
     }
 
+    /// One layer of RTW over the matrix base of `raw` (its tables at their offsets)
+    /// with the split rule of `subdivision`, `near` in the rule's last slot; and the
+    /// rule's levels.
+    fn rtw_layer(
+        &self,
+        raw: &RtwShadowRaw,
+        subdivision: &RtwSubdivision,
+        near: f32,
+    ) -> (RefineLayerRaw, u32) {
+        let [u, v, ..] = raw.sizes;
+        let rule = subdivision.split_rule(u as usize, v as usize);
+        let layer = RefineLayerRaw {
+            uv_from_world: raw.uv_from_world,
+            tables: [raw.table_offsets[0], u, raw.table_offsets[1], v],
+            rule: [
+                rule.pieces.x as f32,
+                rule.pieces.y as f32,
+                rule.error_scale as f32,
+                near,
+            ],
+        };
+        (layer, rule.levels)
+    }
+
     /// Brings the tables of `uniforms` into the pass's table buffer (queued from a
     /// slice, copied inside `encoder` from a GPU buffer).
     fn upload_tables(
@@ -492,34 +532,20 @@ impl GpuRefine {
         encoder: &mut wgpu::CommandEncoder,
         uniforms: &DepthUniforms<'_>,
     ) -> Result<(), BackendError> {
-        let (tables, needed): (&[f32], usize) = match uniforms {
-            DepthUniforms::Rtw { raw, tables } => (tables, rtw_table_texels(raw)),
-            DepthUniforms::WarpedParaboloid { layers, tables } => (
-                tables,
-                layers
-                    .iter()
-                    .map(|l| warp_table_end(&l.warp))
-                    .max()
-                    .unwrap_or(0),
-            ),
-            DepthUniforms::RtwGpuTables { raw, tables } => {
-                let bytes = (rtw_table_texels(raw).max(1) * 4) as u64;
-                if tables.size() < bytes || !tables.usage().contains(wgpu::BufferUsages::COPY_SRC) {
-                    return Err(BackendError::InvalidInput(
-                        "RTW table buffer shorter than its sizes or without COPY_SRC",
-                    ));
-                }
-                self.grow_tables(ctx, bytes);
-                encoder.copy_buffer_to_buffer(tables, 0, &self.tables, 0, bytes);
-                return Ok(());
+        if let DepthUniforms::RtwGpuTables { raw, tables } = uniforms {
+            let bytes = (rtw_table_texels(raw).max(1) * 4) as u64;
+            if tables.size() < bytes || !tables.usage().contains(wgpu::BufferUsages::COPY_SRC) {
+                return Err(BackendError::InvalidInput(
+                    "RTW table buffer shorter than its sizes or without COPY_SRC",
+                ));
             }
-            DepthUniforms::Matrix(_) | DepthUniforms::Paraboloid(_) => return Ok(()),
-        };
-        if tables.len() < needed.max(1) {
-            return Err(BackendError::InvalidInput(
-                "RTW tables shorter than their sizes",
-            ));
+            self.grow_tables(ctx, bytes);
+            encoder.copy_buffer_to_buffer(tables, 0, &self.tables, 0, bytes);
+            return Ok(());
         }
+        let Some(tables) = uniforms.cpu_tables()? else {
+            return Ok(());
+        };
         let bytes: &[u8] = bytemuck::cast_slice(tables);
         self.grow_tables(ctx, bytes.len() as u64);
         ctx.queue.write_buffer(&self.tables, 0, bytes);
@@ -539,7 +565,10 @@ impl GpuRefine {
                 .copied()
                 .ok_or_else(|| BackendError::Readback("short refine stats".into()))
         };
-        let layer_triangles = [word(DRAWN_WORD)?, word(DRAWN_WORD + 1)?];
+        let mut layer_triangles = [0; MAX_LAYERS as usize];
+        for (layer, drawn) in layer_triangles.iter_mut().enumerate() {
+            *drawn = word(DRAWN_WORD + layer)?;
+        }
         Ok(RefineStats {
             triangles: layer_triangles.iter().sum(),
             layer_triangles,
@@ -592,6 +621,14 @@ impl GpuRefine {
     }
 }
 
+/// A layer count of one refinement: 1 to [`MAX_LAYERS`].
+fn checked_layers(count: usize) -> Result<u32, BackendError> {
+    u32::try_from(count)
+        .ok()
+        .filter(|n| (1..=MAX_LAYERS).contains(n))
+        .ok_or(BackendError::InvalidInput("refine: one to six layers"))
+}
+
 /// The paraboloid base of `layers` (one map, one side per layer) into `params`.
 fn paraboloid_params(
     params: &mut RefineParamsRaw,
@@ -600,7 +637,7 @@ fn paraboloid_params(
     levels: u32,
 ) -> Result<(), BackendError> {
     let count = u32::try_from(layers.len()).unwrap_or(u32::MAX);
-    let Some(first) = layers.first().filter(|_| count <= MAX_LAYERS) else {
+    let Some(first) = layers.first().filter(|_| count <= 2) else {
         return Err(BackendError::InvalidInput(
             "refine: one or two paraboloid layers",
         ));
@@ -724,6 +761,7 @@ mod tests {
             ("OVERFLOW", OVERFLOW_WORD as u64),
             ("MODE_PARABOLOID", u64::from(MODE_PARABOLOID)),
             ("MODE_GRID", u64::from(MODE_GRID)),
+            ("MODE_WINDOW", u64::from(MODE_WINDOW)),
         ] {
             let line = format!("const {name}: u32 = {value}u;");
             assert!(source.contains(&line), "shader lacks `{line}`");

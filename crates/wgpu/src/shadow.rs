@@ -54,12 +54,12 @@ impl HeadlessRenderer {
 /// Calls `f` with the renderer's [`ShadowTechnique`] for a fitted shadow: the one
 /// match from the umbrella crate's results to the backend's passes (RTW's borrowed
 /// view of its tables lives for the call). RTW runs over whatever base it was fitted
-/// on: the uniform fit (orthographic), the spot fit (perspective) or the sides of the
-/// IPSM paraboloid (`point_rtw`).
+/// on: the uniform fit (orthographic), the spot fit (perspective), the kept faces of
+/// a cube map (`cube_rtw`) or the sides of the IPSM paraboloid (`point_rtw`).
 ///
 /// # Errors
-/// [`BackendError::InvalidInput`] for a result the backend has no pass for (RTW over
-/// cube faces, a `Fitted` variant added after this backend).
+/// [`BackendError::InvalidInput`] for a result the backend has no pass for (a
+/// `Fitted` variant added after this backend).
 pub fn with_technique<R>(
     shadow: &Shadow,
     f: impl FnOnce(&ShadowTechnique<'_>) -> R,
@@ -83,6 +83,7 @@ pub fn with_technique<R>(
         },
         (Fitted::WarpedCascades { cascades, .. }, _) => ShadowTechnique::WarpedCascades(cascades),
         (Fitted::Cube(cube), _) => ShadowTechnique::Cube(cube),
+        (Fitted::CubeRtw { cube, warps }, _) => ShadowTechnique::CubeRtw { cube, warps },
         _ => return Err(UNSUPPORTED),
     };
     Ok(f(&technique))

@@ -407,6 +407,16 @@ pub struct RtwShadowRaw {
     /// resolution into `w` (the vertex shader snaps to its subpixel grid, see
     /// `shaders/depth_rtw.wgsl`); the lookup ignores it.
     pub sizes: [u32; 4],
+    /// `x`, `y`: where the `u` and the `v` table start in the table buffer (0 and
+    /// `sizes.x` for one map; several layers share one buffer); `z`, `w`: 0.
+    pub table_offsets: [u32; 4],
+    /// `x`, `y`: scale of the warped `uv` into the top-left corner of its layer (1
+    /// where the map fills the layer; cube faces of different sizes,
+    /// `CubeFace::uv_scale_in_layer`); `z`: the base's near plane as its clip `w`
+    /// (a perspective window whose casters the GPU refinement cuts to its frustum,
+    /// as `shadowmap_rtw::subdivide_for_rtw_clipped`), 0 for a base that is not
+    /// cut; `w`: 0.
+    pub layer: [f32; 4],
 }
 
 impl ToRaw for RtwShadow<'_> {
@@ -430,6 +440,8 @@ impl RtwShadowRaw {
             clip_from_world: cols(&base.clip_from_world),
             uv_from_world: cols(&base.uv_from_world),
             sizes: [u_texels, v_texels, u32::from(base.reversed_z), 0],
+            table_offsets: [0, u_texels, 0, 0],
+            layer: [1.0, 1.0, 0.0, 0.0],
         }
     }
 
@@ -445,6 +457,75 @@ impl RtwShadowRaw {
             v.push(0.0);
         }
         v
+    }
+}
+
+/// Most faces of a cube map (layers of [`WarpedCubeLookupRaw`]).
+pub const CUBE_FACES: usize = 6;
+
+/// The lookup of RTW over the kept faces of a cube map (`cube_rtw`): WGSL
+/// `WarpedCube`. A point is looked up in the first face whose window holds it (the
+/// windows are disjoint up to rounding, as the cube lookup selects), then warped
+/// through that face's tables and scaled into its layer's corner.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct WarpedCubeLookupRaw {
+    /// One block per kept face, in layer order (unused entries zero).
+    pub faces: [RtwShadowRaw; CUBE_FACES],
+    /// `x`: kept faces; `y`, `z`, `w`: 0.
+    pub count: [u32; 4],
+}
+
+/// RTW over the kept faces of a cube map (`cube_rtw`): the depth pass's blocks, the
+/// lookup's block and the one table buffer both read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WarpedCube {
+    /// One block per kept face (its perspective base, tables and corner).
+    pub layers: Vec<RtwShadowRaw>,
+    /// The lookup.
+    pub lookup: WarpedCubeLookupRaw,
+    /// The tables: face 0's `u` then `v`, face 1's, ... (one zero when there are
+    /// none).
+    pub tables: Vec<f32>,
+}
+
+/// The blocks and tables of a cube map whose kept faces are warped by `warps` (one
+/// pair of tables per face, in face order; a face without tables is not warped).
+/// Each face renders into the top-left corner of a layer of the largest face's side
+/// (render at `CubeMap::largest_side`), its casters cut to its window's frustum.
+#[must_use]
+pub fn warped_cube(cube: &CubeMap, warps: &[WarpMaps]) -> WarpedCube {
+    let side = cube.largest_side();
+    let mut layers = Vec::with_capacity(cube.faces.len());
+    let mut tables = Vec::new();
+    for (layer, face) in cube.faces.iter().enumerate() {
+        let Some(base) = cube.transform(layer as u32) else {
+            continue;
+        };
+        let (x, y): (&[f32], &[f32]) = warps
+            .get(layer)
+            .map_or((&[], &[]), |w| (w.x_table(), w.y_table()));
+        let mut raw = RtwShadowRaw::from_base(&base, x.len() as u32, y.len() as u32);
+        let at = tables.len() as u32;
+        raw.table_offsets = [at, at + x.len() as u32, 0, 0];
+        let scale = face.uv_scale_in_layer(side);
+        raw.layer = [scale.x, scale.y, face.near, 0.0];
+        tables.extend_from_slice(x);
+        tables.extend_from_slice(y);
+        layers.push(raw);
+    }
+    if tables.is_empty() {
+        tables.push(0.0);
+    }
+    let mut lookup = WarpedCubeLookupRaw::zeroed();
+    for (slot, raw) in lookup.faces.iter_mut().zip(&layers) {
+        *slot = *raw;
+    }
+    lookup.count[0] = layers.len().min(CUBE_FACES) as u32;
+    WarpedCube {
+        layers,
+        lookup,
+        tables,
     }
 }
 

@@ -6,19 +6,27 @@
 //! a DPSM of the same light shadows.
 
 use glam::Vec3;
+use shadowmap::Fitted;
 use shadowmap::paraboloid::{CubeMap, CubeOptions, FaceSizes};
 use shadowmap::{FitInput, Technique, fit};
+use shadowmap_eval::bvh::Bvh;
+use shadowmap_eval::mask::GBuffer;
+use shadowmap_eval::metrics::ScreenGeometry;
 use shadowmap_eval::raster::{DepthMap, MatrixProjector, RasterOptions, rasterize_depth};
 use shadowmap_eval::scene::Scene;
+use shadowmap_eval::technique::{
+    FrameContext, Technique as EvalTechnique, TechniqueKind, TechniqueOptions, eye_samples,
+};
 use shadowmap_frustum::{Camera, Light, Projection, SceneBounds};
 use shadowmap_wgpu::depth::DepthBias;
 use shadowmap_wgpu::depth::{
     DepthPassDesc, DepthTechnique, DepthUniforms, MeshBuffers, ShadowDepthPass,
 };
+use shadowmap_wgpu::refine::{GpuRefine, RefineOptions};
 use shadowmap_wgpu::render::{
     HeadlessRenderer, MaskValue, RenderOptions, ShadowBias, ShadowFilter,
 };
-use shadowmap_wgpu::uniforms::ToRaw;
+use shadowmap_wgpu::uniforms::{ToRaw, warped_cube};
 
 const RES: u32 = 256;
 
@@ -257,5 +265,92 @@ fn cube_faces_of_different_sides_match_the_cpu_rasterizer() {
     eprintln!(
         "cube by need (side {side}): {differing} of {compared} texels differ ({fraction:.5})"
     );
+    assert!(fraction <= 1e-3, "{differing} of {compared} texels differ");
+}
+
+/// RTW over the kept faces of a cube map (`cube_rtw`, faces sized by need, each with
+/// its own warp tables): the casters cut to each face's window frustum and refined
+/// on the GPU, drawn through the face's base and tables into its layer's corner,
+/// match eval's reference (the CPU clip and subdivision, then its rasterizer) at the
+/// face's own size, within the tolerance of the other depth tests.
+#[test]
+fn warped_cube_faces_match_the_cpu_reference() {
+    let Some(ctx) =
+        shadowmap_wgpu::context::test_context("warped_cube_faces_match_the_cpu_reference")
+    else {
+        return;
+    };
+    let (scene, tris, camera, lamp) = lamp_among_buildings();
+    let (width, height) = (320, 240);
+    let bvh = Bvh::build(&scene.mesh).unwrap();
+    let gbuffer = GBuffer::trace(&bvh, &camera, width, height).unwrap();
+    let samples = eye_samples(&gbuffer, &camera);
+    let screen = ScreenGeometry::new(&camera, width, height).unwrap();
+    let frame = FrameContext {
+        camera: &camera,
+        light: &lamp,
+        scene: scene.scene_bounds().unwrap(),
+        eye_samples: &samples,
+        pixels_per_radian: screen.pixels_per_radian().unwrap() as f32,
+    };
+    let options = TechniqueOptions::default().with_texel_budget(384 * 384);
+    let technique = EvalTechnique::build(TechniqueKind::CubeRtw, &frame, &options).unwrap();
+    let Fitted::CubeRtw { cube, warps } = technique.shadow().fitted() else {
+        panic!("cube_rtw fits a cube map with tables");
+    };
+    assert!(cube.layers() >= 3, "{} faces", cube.layers());
+    let cpu = technique
+        .rasterize(&scene.mesh, &RasterOptions::default())
+        .unwrap();
+    let side = cube.largest_side();
+    let warped = warped_cube(cube, warps);
+    let uniforms = DepthUniforms::WarpedCube {
+        layers: &warped.layers,
+        tables: &warped.tables,
+    };
+    let gpu = ctx
+        .scoped(|ctx| {
+            let refine_options = RefineOptions::default()
+                .with_resolution(side)
+                .with_capacity(3 << 20);
+            let mut refine = GpuRefine::new(ctx, &tris, &refine_options)?;
+            let desc = DepthPassDesc::new(DepthTechnique::Rtw, side).with_layers(cube.layers());
+            let mut pass = ShadowDepthPass::new(ctx, &desc)?;
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            refine.encode(ctx, &mut encoder, &uniforms)?;
+            pass.encode_refined(ctx, &mut encoder, &refine, &uniforms)?;
+            ctx.queue.submit([encoder.finish()]);
+            let stats = refine.read_stats(ctx)?;
+            eprintln!("{stats:?}");
+            assert!(!stats.overflowed, "refined at the CPU's depth");
+            assert!(
+                stats.layer_triangles[..cube.faces.len()]
+                    .iter()
+                    .all(|&n| n > 0)
+            );
+            pass.readback_depth(ctx)
+        })
+        .expect("GPU depth pass");
+    let n = (side * side) as usize;
+    let (mut differing, mut compared, mut offset) = (0, 0, 0);
+    for (layer, face) in cube.faces.iter().enumerate() {
+        let [w, h] = face.size;
+        assert_eq!(cpu.layer_size(layer as u32), (w, h));
+        let corner = &gpu[layer * n..(layer + 1) * n];
+        let mut face_differing = 0;
+        for row in 0..h as usize {
+            for col in 0..w as usize {
+                let g = corner[row * side as usize + col];
+                let c = cpu.depth[offset + row * w as usize + col];
+                face_differing += usize::from((g - c).abs() > 1e-4);
+            }
+        }
+        eprintln!("face {layer} ({w}x{h}): {face_differing} texels differ");
+        differing += face_differing;
+        compared += (w * h) as usize;
+        offset += (w * h) as usize;
+    }
+    let fraction = differing as f64 / compared as f64;
+    eprintln!("cube_rtw (side {side}): {differing} of {compared} texels differ ({fraction:.5})");
     assert!(fraction <= 1e-3, "{differing} of {compared} texels differ");
 }

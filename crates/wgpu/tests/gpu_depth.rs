@@ -341,7 +341,8 @@ fn bad_inputs_are_typed_errors() {
     assert!(
         ShadowDepthPass::new(
             &ctx,
-            &DepthPassDesc::new(DepthTechnique::Rtw, 64).with_layers(2)
+            &DepthPassDesc::new(DepthTechnique::Rtw, 64)
+                .with_layers(shadowmap_wgpu::refine::MAX_LAYERS + 1)
         )
         .is_err()
     );

@@ -229,33 +229,8 @@ fn gpu_misclassification_matches_the_cpu_for_every_technique() {
         checked.extend(misclassification_gaps(&ctx, &configuration(name)));
     }
     for kind in TechniqueKind::ALL {
-        if kind != TechniqueKind::CubeRtw {
-            assert!(checked.contains(&kind), "{} not compared", kind.name());
-        }
+        assert!(checked.contains(&kind), "{} not compared", kind.name());
     }
-}
-
-/// The one technique without a pass in the backend, RTW over cube faces, is refused
-/// with a typed error rather than rendered wrong; when it gets a pass, it joins the
-/// comparison above.
-#[test]
-fn without_a_pass_is_refused() {
-    let config = configuration("point_mid");
-    let frame = ReportFrame::new(&config);
-    let context = FrameContext {
-        camera: config.camera(),
-        light: &config.light,
-        scene: config.scene.scene_bounds().unwrap(),
-        eye_samples: &frame.samples,
-        pixels_per_radian: frame.pixels_per_radian,
-    };
-    let options = TechniqueOptions::default().with_texel_budget(256 * 256);
-    let technique = Technique::build(TechniqueKind::CubeRtw, &context, &options).unwrap();
-    let result = shadowmap_wgpu::shadow::with_technique(technique.shadow(), |_| ());
-    assert!(matches!(
-        result,
-        Err(shadowmap_wgpu::BackendError::InvalidInput(_))
-    ));
 }
 
 /// One configuration's frame at 480x270, traced on the CPU: what eval's
@@ -363,12 +338,6 @@ fn misclassification_gaps(ctx: &GpuContext, config: &Configuration) -> Vec<Techn
     let mut renderer = HeadlessRenderer::new();
     let mut checked = Vec::new();
     for kind in TechniqueKind::for_light(light) {
-        if kind == TechniqueKind::CubeRtw {
-            // The backend has no pass for RTW over cube faces (see
-            // `without_a_pass_is_refused`); point lights get RTW on the GPU over
-            // the IPSM paraboloid (`point_rtw`).
-            continue;
-        }
         let (cpu, gpu) = frame.masks(ctx, &mut renderer, kind, 512 * 512);
         let cpu = cpu.compare(&frame.truth);
         let (gpu, _) = misclassification(&gpu, &volume_mask);
@@ -392,9 +361,10 @@ fn misclassification_gaps(ctx: &GpuContext, config: &Configuration) -> Vec<Techn
     checked
 }
 
-/// RTW over the perspective base of the spot fit (`spot_rtw`) and over the sides of
-/// the IPSM paraboloid (`point_rtw`, one side and two): the GPU mask (casters
-/// refined on the GPU, warped depth pass and lookup) equals eval's CPU mask on all
+/// RTW over the perspective base of the spot fit (`spot_rtw`), over the kept faces of
+/// a cube map (`cube_rtw`, five and six faces) and over the sides of the IPSM
+/// paraboloid (`point_rtw`, one side and two): the GPU mask (casters refined on the
+/// GPU, warped depth pass and lookup) equals eval's CPU mask on all
 /// but 0.1% of the pixels both classify (the rest are silhouette pixels, where the
 /// rasterized and the ray-traced primary surface differ).
 #[test]
@@ -409,6 +379,9 @@ fn rtw_over_spot_and_paraboloid_bases_matches_the_cpu_reference() {
         ("point_mid", TechniqueKind::PointRtw),
         ("point_inside", TechniqueKind::PointRtw),
         ("point_far", TechniqueKind::PointRtw),
+        ("point_mid", TechniqueKind::CubeRtw),
+        ("point_inside", TechniqueKind::CubeRtw),
+        ("facing_point", TechniqueKind::CubeRtw),
     ];
     let mut renderer = HeadlessRenderer::new();
     for (name, kind) in cases {

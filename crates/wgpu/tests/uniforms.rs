@@ -13,7 +13,8 @@ use shadowmap::{CascadePlan, DpsmOptions, FitInput, Fitted, Technique, fit};
 use shadowmap_wgpu::shaders;
 use shadowmap_wgpu::uniforms::{
     CascadeShadowRaw, FrameRaw, MatrixShadowRaw, ParaboloidLayerRaw, ParaboloidLookupRaw,
-    RtwShadowRaw, ToRaw, cascade_layers, paraboloid_layers, warped_cascade_layers,
+    RtwShadowRaw, ToRaw, WarpedCubeLookupRaw, cascade_layers, paraboloid_layers,
+    warped_cascade_layers,
 };
 
 /// (struct span, member offsets) of `name` in `source`, by naga's layouter.
@@ -146,10 +147,25 @@ fn rtw_and_frame_blocks_match() {
         ("clip_from_world", offset_of!(RtwShadowRaw, clip_from_world)),
         ("uv_from_world", offset_of!(RtwShadowRaw, uv_from_world)),
         ("sizes", offset_of!(RtwShadowRaw, sizes)),
+        ("table_offsets", offset_of!(RtwShadowRaw, table_offsets)),
+        ("layer", offset_of!(RtwShadowRaw, layer)),
     ];
-    for source in [shaders::DEPTH_RTW, shaders::LOOKUP_RTW] {
+    for source in [
+        shaders::DEPTH_RTW,
+        shaders::LOOKUP_RTW,
+        shaders::LOOKUP_CUBE_RTW,
+    ] {
         check(source, "RtwShadow", size_of::<RtwShadowRaw>(), &rtw);
     }
+    check(
+        shaders::LOOKUP_CUBE_RTW,
+        "WarpedCube",
+        size_of::<WarpedCubeLookupRaw>(),
+        &[
+            ("faces", offset_of!(WarpedCubeLookupRaw, faces)),
+            ("count", offset_of!(WarpedCubeLookupRaw, count)),
+        ],
+    );
     check(
         shaders::RENDER_SCENE,
         "Frame",

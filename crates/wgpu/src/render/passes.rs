@@ -13,7 +13,9 @@ use crate::depth::{
 };
 use crate::profile::GpuProfiler;
 use crate::refine::RefineOptions;
-use crate::uniforms::{FrameRaw, RtwShadowRaw, ToRaw, paraboloid_layers, warped_paraboloid};
+use crate::uniforms::{
+    FrameRaw, RtwShadowRaw, ToRaw, paraboloid_layers, warped_cube, warped_paraboloid,
+};
 use crate::{BackendError, GpuContext};
 
 /// The tables the lookup reads (RTW's, a warped paraboloid's).
@@ -99,6 +101,19 @@ impl DepthJob<'_> {
                     tables: &warped.tables,
                 };
                 let desc = self.desc(DepthTechnique::Paraboloid, warped.layers.len());
+                let pass = job.record(encoder, &desc, &uniforms, profiler)?;
+                Ok(DepthOutput {
+                    pass,
+                    tables: LookupTables::Owned(warped.tables),
+                })
+            }
+            ShadowTechnique::CubeRtw { cube, warps } => {
+                let warped = warped_cube(cube, warps);
+                let uniforms = DepthUniforms::WarpedCube {
+                    layers: &warped.layers,
+                    tables: &warped.tables,
+                };
+                let desc = self.desc(DepthTechnique::Rtw, warped.layers.len());
                 let pass = job.record(encoder, &desc, &uniforms, profiler)?;
                 Ok(DepthOutput {
                     pass,

@@ -10,7 +10,7 @@ use shadowmap_warp::{WarpedCascades, XpsmShadow};
 use crate::rtw::GpuRtw;
 use crate::uniforms::{
     CascadeShadowRaw, MatrixShadowRaw, ParaboloidLookupRaw, RtwShadowRaw, ToRaw, cascade_layers,
-    cube_layers, warped_cascade_layers, warped_paraboloid,
+    cube_layers, warped_cascade_layers, warped_cube, warped_paraboloid,
 };
 use crate::{BackendError, compose, shaders};
 
@@ -63,6 +63,19 @@ pub enum ShadowTechnique<'a> {
     /// holds the point, the windows being disjoint up to rounding) with the `uv`
     /// divided by `w` and scaled to the face's corner.
     Cube(&'a CubeMap),
+    /// Rectilinear texture warping over the kept faces of a cube map (`cube_rtw`):
+    /// one layer per face, each face's casters cut to its window frustum and refined
+    /// on the GPU, drawn through the face's perspective base and tables into the
+    /// top-left corner of a layer of the largest face's side (render at
+    /// `CubeMap::largest_side`); the lookup selects the face by projection, as
+    /// [`ShadowTechnique::Cube`] does, then warps.
+    CubeRtw {
+        /// The cube map whose faces are warped.
+        cube: &'a CubeMap,
+        /// One pair of tables per kept face, in face order (a face without tables
+        /// is not warped).
+        warps: &'a [WarpMaps],
+    },
 }
 
 /// Which lookup shader.
@@ -72,6 +85,7 @@ pub(super) enum Lookup {
     Cascades,
     Paraboloid,
     Rtw,
+    CubeRtw,
 }
 
 impl Lookup {
@@ -82,6 +96,7 @@ impl Lookup {
             Self::Cascades => Ok(shaders::LOOKUP_CASCADES.to_owned()),
             Self::Paraboloid => compose::lookup_paraboloid(),
             Self::Rtw => compose::lookup_rtw(),
+            Self::CubeRtw => compose::lookup_cube_rtw(),
         }
     }
 }
@@ -96,6 +111,7 @@ impl ShadowTechnique<'_> {
             | Self::Cube(_) => Lookup::Cascades,
             Self::Paraboloid(_) | Self::ParaboloidRtw { .. } => Lookup::Paraboloid,
             Self::Rtw(_) | Self::RtwGpu { .. } => Lookup::Rtw,
+            Self::CubeRtw { .. } => Lookup::CubeRtw,
         }
     }
 
@@ -116,7 +132,10 @@ impl ShadowTechnique<'_> {
                 .map(|s| &s.transform),
             Self::Rtw(r) => Some(&r.base),
             Self::RtwGpu { base, .. } => Some(base),
-            Self::Paraboloid(_) | Self::ParaboloidRtw { .. } | Self::Cube(_) => None,
+            Self::Paraboloid(_)
+            | Self::ParaboloidRtw { .. }
+            | Self::Cube(_)
+            | Self::CubeRtw { .. } => None,
         }
     }
 
@@ -130,7 +149,9 @@ impl ShadowTechnique<'_> {
             Self::Paraboloid(m) | Self::ParaboloidRtw { map: m, .. } => {
                 Ok(LightDirection::Position(m.position))
             }
-            Self::Cube(c) => Ok(LightDirection::Position(c.position)),
+            Self::Cube(c) | Self::CubeRtw { cube: c, .. } => {
+                Ok(LightDirection::Position(c.position))
+            }
             _ => self
                 .first_transform()
                 .map(|t| t.light)
@@ -141,7 +162,7 @@ impl ShadowTechnique<'_> {
     pub(super) fn reversed_z(&self) -> bool {
         match self {
             Self::Paraboloid(m) | Self::ParaboloidRtw { map: m, .. } => m.reversed_z,
-            Self::Cube(c) => c.reversed_z,
+            Self::Cube(c) | Self::CubeRtw { cube: c, .. } => c.reversed_z,
             _ => self.first_transform().is_some_and(|t| t.reversed_z),
         }
     }
@@ -158,7 +179,8 @@ impl ShadowTechnique<'_> {
             Self::Paraboloid(_)
             | Self::ParaboloidRtw { .. }
             | Self::Rtw(_)
-            | Self::RtwGpu { .. } => None,
+            | Self::RtwGpu { .. }
+            | Self::CubeRtw { .. } => None,
         }
     }
 
@@ -182,6 +204,9 @@ impl ShadowTechnique<'_> {
                 bytemuck::bytes_of(&warped_paraboloid(map, Some(front), *back).lookup).to_vec()
             }
             Self::Cube(c) => bytemuck::bytes_of(&CascadeShadowRaw::from_cube(c)).to_vec(),
+            Self::CubeRtw { cube, warps } => {
+                bytemuck::bytes_of(&warped_cube(cube, warps).lookup).to_vec()
+            }
             Self::Rtw(r) => bytemuck::bytes_of(&r.to_raw()).to_vec(),
             Self::RtwGpu { base, rtw } => {
                 bytemuck::bytes_of(&RtwShadowRaw::from_base(base, rtw.width(), rtw.height()))
