@@ -176,14 +176,30 @@ fn fit_faces(options: &CubeOptions, input: &FitInput<'_>) -> Result<CubeMap, Fit
     )?)
 }
 
-/// The needs ([`oracle_needs`]) of the samples stored in a cube's `layer` for which
-/// `keep` holds, into `out` (cleared first).
+/// The samples each kept face of `cube` stores (its layer's entry), in their order:
+/// each sample is mapped once, and each face's needs are then computed on its own
+/// samples only.
+fn samples_by_face(cube: &CubeMap, samples: &[EyeSample]) -> ArrayVec<Vec<EyeSample>, 6> {
+    let mut by_face: ArrayVec<Vec<EyeSample>, 6> = (0..cube.layers()).map(|_| Vec::new()).collect();
+    for s in samples {
+        if let Some(face) = cube
+            .map_point(s.position.as_dvec3())
+            .and_then(|x| by_face.get_mut(x.layer as usize))
+        {
+            face.push(*s);
+        }
+    }
+    by_face
+}
+
+/// The needs ([`oracle_needs`]) of the samples a cube's `layer` stores
+/// ([`samples_by_face`]) for which `keep` holds, into `out` (cleared first).
 fn stored_needs(
     cube: &CubeMap,
     layer: u32,
     camera: &shadowmap_frustum::Camera,
     pixels_per_radian: f32,
-    samples: &[EyeSample],
+    stored: &[EyeSample],
     out: &mut Vec<AxisNeed>,
     mut keep: impl FnMut(&AxisNeed) -> bool,
 ) -> Result<(), FitError> {
@@ -191,11 +207,8 @@ fn stored_needs(
     let Some(base) = cube.transform(layer) else {
         return Ok(());
     };
-    oracle_needs(&base, camera, pixels_per_radian, samples, |i, need| {
-        let stored = cube
-            .map_point(samples[i].position.as_dvec3())
-            .is_some_and(|s| s.layer == layer);
-        if stored && keep(&need) {
+    oracle_needs(&base, camera, pixels_per_radian, stored, |_, need| {
+        if keep(&need) {
             out.push(need);
         }
     })?;
@@ -235,7 +248,8 @@ pub(crate) fn fit_cube_rtw(
     let mut warps = Vec::with_capacity(cube.faces.len());
     let mut needs: ArrayVec<Option<[f64; 2]>, 6> = ArrayVec::new();
     let mut face_needs: Vec<AxisNeed> = Vec::new();
-    for layer in 0..cube.layers() {
+    let by_face = samples_by_face(&cube, samples);
+    for (layer, stored) in (0..cube.layers()).zip(&by_face) {
         map_u.clear();
         map_v.clear();
         stored_needs(
@@ -243,7 +257,7 @@ pub(crate) fn fit_cube_rtw(
             layer,
             input.camera,
             pixels_per_radian,
-            samples,
+            stored,
             &mut face_needs,
             |n| map_u.splat_need(n.uv, n.u) && map_v.splat_need(n.uv, n.v),
         )?;

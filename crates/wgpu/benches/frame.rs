@@ -3,7 +3,8 @@
 //! depth passes (needs an adapter; skipped without one). `rtw_frame_cpu`: the CPU
 //! cost of a whole RTW frame with the tables built and the casters refined on the
 //! GPU; `ipsm_frame_cpu`: the same for IPSM (and DPSM beside it), the casters refined
-//! against the paraboloid on the GPU.
+//! against the paraboloid on the GPU; `cube_rtw_frame_cpu`: the same for RTW over
+//! the cube faces of a lamp, and its fit.
 
 use std::hint::black_box;
 
@@ -27,7 +28,7 @@ use shadowmap_wgpu::depth::{
 use shadowmap_wgpu::refine::{GpuRefine, RefineOptions};
 use shadowmap_wgpu::rtw::{GpuRtw, RtwGBufferTextures};
 use shadowmap_wgpu::uniforms::{
-    ParaboloidLayerRaw, RtwShadowRaw, ToRaw, cascade_layers, paraboloid_layers,
+    ParaboloidLayerRaw, RtwShadowRaw, ToRaw, cascade_layers, paraboloid_layers, warped_cube,
 };
 
 fn camera() -> Camera {
@@ -454,6 +455,91 @@ fn ipsm_frame_cpu(c: &mut Criterion) {
     g.finish();
 }
 
+/// CPU time to prepare and record one frame of RTW over the cube faces of a lamp
+/// among the city block's buildings (`cube_rtw`, 2048² of texels in all): the
+/// blocks and the tables of every kept face packed ([`warped_cube`]), the casters
+/// clipped to each face's window and refined on the GPU, the depth pass drawn
+/// indirectly, uploads flushed; and the fit before it (`cube_rtw_fit`: the oracle's
+/// needs of a 480x270 ground G-buffer, one pair of 256-cell tables per face).
+fn cube_rtw_frame_cpu(c: &mut Criterion) {
+    let cam = camera();
+    let lamp = Light::Point {
+        position: Vec3::new(3.0, 30.0, -2.0),
+        range: 400.0,
+    };
+    let samples: Vec<EyeSample> = ground_gbuffer(480, 270).into_iter().flatten().collect();
+    let scene = SceneBounds::whole(Aabb::new(
+        Vec3::new(-200.0, 0.0, -200.0),
+        Vec3::new(200.0, 60.0, 200.0),
+    ));
+    let pixels_per_radian = 270.0 / 2.0 / 0.5f32.tan();
+    let input = FitInput::new(&cam, &lamp, scene, 2048 * 2048)
+        .with_eye_samples(&samples)
+        .with_pixels_per_radian(pixels_per_radian);
+    let technique = Technique::CubeRtw {
+        cube: Default::default(),
+        rtw: Default::default(),
+    };
+    // The fit first, before any GPU work is queued (a software adapter's threads
+    // would share the CPU with it).
+    c.bench_function("cube_rtw_fit/city_block_lamp_2048", |b| {
+        b.iter(|| black_box(fit(black_box(&technique), &input).is_ok()));
+    });
+    let shadow = fit(&technique, &input).expect("cube_rtw");
+    let Fitted::CubeRtw { cube, warps } = shadow.fitted() else {
+        return;
+    };
+    let Ok(ctx) = GpuContext::new_headless() else {
+        eprintln!("cube_rtw_frame_cpu: no adapter, not measured");
+        return;
+    };
+    let side = cube.largest_side();
+    let casters = city_casters();
+    let setup = ctx.scoped(|ctx| {
+        let refine = GpuRefine::new(
+            ctx,
+            &casters,
+            &RefineOptions::default().with_resolution(side),
+        )?;
+        let desc = DepthPassDesc::new(DepthTechnique::Rtw, side).with_layers(cube.layers());
+        Ok((refine, ShadowDepthPass::new(ctx, &desc)?))
+    });
+    let Ok((mut refine, mut pass)) = setup else {
+        eprintln!("cube_rtw_frame_cpu: setup failed");
+        return;
+    };
+    let mut record = || {
+        let warped = warped_cube(cube, warps);
+        let uniforms = DepthUniforms::WarpedCube {
+            layers: &warped.layers,
+            tables: &warped.tables,
+        };
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let ok = refine
+            .encode(&ctx, &mut encoder, &uniforms)
+            .and_then(|()| pass.encode_refined(&ctx, &mut encoder, &refine, &uniforms))
+            .is_ok();
+        (ok, encoder.finish())
+    };
+    let (ok, commands) = record();
+    ctx.queue.submit([commands]);
+    eprintln!(
+        "cube_rtw_frame_cpu: {} faces, side {side}, {} casters, recorded {ok}",
+        cube.layers(),
+        casters.len()
+    );
+    let mut g = c.benchmark_group("cube_rtw_frame_cpu");
+    g.bench_function("city_block_lamp_2048_gpu_refine", |b| {
+        b.iter(|| {
+            let recorded = black_box(record());
+            ctx.queue.submit([]);
+            recorded.0
+        });
+    });
+    g.finish();
+}
+
 criterion_group!(benches, packing);
-criterion_group!(frame_cpu, rtw_frame_cpu, ipsm_frame_cpu);
-criterion_main!(benches, frame_cpu);
+// `cube_rtw_frame_cpu` first: its fit is timed before any GPU work is queued.
+criterion_group!(frame_cpu, cube_rtw_frame_cpu, rtw_frame_cpu, ipsm_frame_cpu);
+criterion_main!(frame_cpu, benches);
