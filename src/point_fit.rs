@@ -8,7 +8,9 @@ use glam::DVec3;
 use shadowmap_frustum::math::sqrt;
 use shadowmap_frustum::{LightDirection, ShadowMapping};
 use shadowmap_paraboloid::{CubeMap, CubeOptions, FaceSizes, IpsmOptions, IpsmPlan, Side};
-use shadowmap_rtw::{AxisNeed, BasePoint, EyeSample, ImportanceMap, WarpMaps, oracle_needs};
+use shadowmap_rtw::{
+    AxisNeed, BasePoint, EyeSample, ImportanceMap, WarpMaps, oracle_needs, oracle_needs_where,
+};
 
 use crate::fit::{FitError, FitInput, layer_side};
 use crate::sample_error::{MAX_SAMPLES, percentile_of, sample_error};
@@ -123,13 +125,16 @@ pub(crate) fn fit_cube(options: &CubeOptions, input: &FitInput<'_>) -> Result<Cu
         for layer in 0..cube.layers() {
             let mut errors: ArrayVec<f64, MAX_SAMPLES> = ArrayVec::new();
             if let Some(base) = cube.transform(layer) {
-                oracle_needs(&base, input.camera, ppr, samples, |i, need| {
-                    let stored = cube
-                        .map_point(samples[i].position.as_dvec3())
-                        .is_some_and(|s| s.layer == layer);
-                    if stored && i % stride == 0 {
-                        let _ = errors.try_push(need.isotropic);
-                    }
+                // Only every `stride`-th sample the face stores is needed: the others
+                // are not computed.
+                let stored = |i: usize, s: &EyeSample| {
+                    i % stride == 0
+                        && cube
+                            .map_point(s.position.as_dvec3())
+                            .is_some_and(|x| x.layer == layer)
+                };
+                oracle_needs_where(&base, input.camera, ppr, samples, stored, |_, need| {
+                    let _ = errors.try_push(need.isotropic);
                 })?;
             }
             needs.push(percentile(&mut errors).map(|m| [m, m]));

@@ -656,4 +656,4 @@ mod oracle;
 #[cfg(test)]
 mod tests;
 
-pub use oracle::{AxisNeed, PixelSteps, oracle_needs};
+pub use oracle::{AxisNeed, PixelSteps, oracle_needs, oracle_needs_where};

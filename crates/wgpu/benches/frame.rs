@@ -11,7 +11,8 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use shadowmap::paraboloid::{
-    IpsmOptions, IpsmPlan, ParaboloidMap, Side, SubdivisionOptions, subdivide_triangles,
+    CubeOptions, FaceSizes, IpsmOptions, IpsmPlan, ParaboloidMap, Side, SubdivisionOptions,
+    subdivide_triangles,
 };
 use shadowmap::{DpsmOptions, FitInput, Fitted, Shadow, Technique, fit};
 use shadowmap_frustum::{
@@ -460,7 +461,8 @@ fn ipsm_frame_cpu(c: &mut Criterion) {
 /// blocks and the tables of every kept face packed ([`warped_cube`]), the casters
 /// clipped to each face's window and refined on the GPU, the depth pass drawn
 /// indirectly, uploads flushed; and the fit before it (`cube_rtw_fit`: the oracle's
-/// needs of a 480x270 ground G-buffer, one pair of 256-cell tables per face).
+/// needs of a 480x270 ground G-buffer, one pair of 256-cell tables per face), with
+/// the cube maps sized by the same samples' needs beside it (`cube_fit_by_need`).
 fn cube_rtw_frame_cpu(c: &mut Criterion) {
     let cam = camera();
     let lamp = Light::Point {
@@ -484,6 +486,11 @@ fn cube_rtw_frame_cpu(c: &mut Criterion) {
     // would share the CPU with it).
     c.bench_function("cube_rtw_fit/city_block_lamp_2048", |b| {
         b.iter(|| black_box(fit(black_box(&technique), &input).is_ok()));
+    });
+    // The cube maps sized by the samples' needs, on the same input.
+    let by_need = Technique::CubeMaps(CubeOptions::default().with_sizes(FaceSizes::ByNeed));
+    c.bench_function("cube_fit_by_need/city_block_lamp_2048", |b| {
+        b.iter(|| black_box(fit(black_box(&by_need), &input).is_ok()));
     });
     let shadow = fit(&technique, &input).expect("cube_rtw");
     let Fitted::CubeRtw { cube, warps } = shadow.fitted() else {

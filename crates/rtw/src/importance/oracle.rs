@@ -39,6 +39,27 @@ pub fn oracle_needs(
     camera: &Camera,
     pixels_per_radian: f32,
     samples: &[EyeSample],
+    each: impl FnMut(usize, AxisNeed),
+) -> Result<usize, RtwError> {
+    // Every sample checked before any is measured: nothing is called on error.
+    check_samples(samples)?;
+    oracle_needs_where(base, camera, pixels_per_radian, samples, |_, _| true, each)
+}
+
+/// [`oracle_needs`] of the samples for which `keep(index, sample)` holds, the others
+/// neither computed nor counted as skipped: for a caller that uses a subset (every
+/// k-th sample, the samples one cube face stores) and would otherwise pay for the
+/// need of every sample and throw most away. No allocation.
+///
+/// # Errors
+/// As [`oracle_needs`], for the kept samples ([`RtwError::NonFinite`] when one is not
+/// finite; nothing is called after it).
+pub fn oracle_needs_where(
+    base: &ShadowTransform,
+    camera: &Camera,
+    pixels_per_radian: f32,
+    samples: &[EyeSample],
+    mut keep: impl FnMut(usize, &EyeSample) -> bool,
     mut each: impl FnMut(usize, AxisNeed),
 ) -> Result<usize, RtwError> {
     if !(pixels_per_radian.is_finite() && pixels_per_radian > 0.0) {
@@ -46,10 +67,13 @@ pub fn oracle_needs(
     }
     camera.validate()?;
     let base = Base::new(base)?;
-    check_samples(samples)?;
     let view = View::new(camera, pixels_per_radian);
     let mut skipped = 0;
     for (i, s) in samples.iter().enumerate() {
+        if !keep(i, s) {
+            continue;
+        }
+        check_samples(core::slice::from_ref(s))?;
         match view.need(&base, s) {
             Some(need) => each(i, need),
             None => skipped += 1,

@@ -213,6 +213,50 @@ fn oracle_needs_are_the_inverse_jacobian() {
     ));
 }
 
+/// The kept samples' needs are `oracle_needs`' for them, at their own indices; a
+/// sample not kept is not measured, not counted and not checked.
+#[test]
+fn oracle_needs_where_measures_only_the_kept_samples() {
+    let base = identity_base();
+    let camera = shadowmap_frustum::Camera::look_to(
+        Vec3::new(0.5, 0.5, 10.0),
+        Vec3::NEG_Z,
+        Vec3::Y,
+        shadowmap_frustum::Projection::perspective(1.0, 1.0, 0.1, 100.0),
+    )
+    .unwrap();
+    let sample = |x: f32| EyeSample {
+        position: Vec3::new(x, 0.5, 0.0),
+        normal: Vec3::Z,
+        eye_distance: 10.0,
+    };
+    let mut samples: Vec<EyeSample> = (0..8).map(|i| sample(0.3 + 0.05 * i as f32)).collect();
+    let mut all = Vec::new();
+    oracle_needs(&base, &camera, 100.0, &samples, |i, n| all.push((i, n))).unwrap();
+    assert_eq!(all.len(), 8);
+    samples[3].position.x = f32::NAN;
+    let mut even = Vec::new();
+    let skipped = oracle_needs_where(
+        &base,
+        &camera,
+        100.0,
+        &samples,
+        |i, _| i % 2 == 0,
+        |i, n| even.push((i, n)),
+    )
+    .unwrap();
+    assert_eq!(skipped, 0);
+    let expected: Vec<_> = all.iter().copied().filter(|(i, _)| i % 2 == 0).collect();
+    assert_eq!(even, expected);
+    // Kept, the non-finite sample is an error; unchecked by `oracle_needs` it is too.
+    let keep_all = oracle_needs_where(&base, &camera, 100.0, &samples, |_, _| true, |_, _| {});
+    assert!(matches!(keep_all, Err(RtwError::NonFinite)));
+    assert!(matches!(
+        oracle_needs(&base, &camera, 100.0, &samples, |_, _| {}),
+        Err(RtwError::NonFinite)
+    ));
+}
+
 #[test]
 fn backward_importance_over_a_perspective_base_grows_with_the_light_depth() {
     // A spot at the origin looking down -Z, 90 degrees wide: the base texel at light
