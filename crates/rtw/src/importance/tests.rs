@@ -200,17 +200,22 @@ fn oracle_needs_are_the_inverse_jacobian() {
     assert!((slanted.v - 10.0).abs() < 1e-4 && (slanted.isotropic - 10.0).abs() < 1e-4);
     let (skipped, grazed) = needs_from(Vec3::NEG_Z, Vec3::X);
     assert_eq!((skipped, grazed), (0, Some(facing)));
-    let camera = shadowmap_frustum::Camera::look_to(
+    let camera = facing_the_base();
+    assert!(matches!(
+        oracle_needs(&base, &camera, 0.0, &[], |_, _| {}),
+        Err(RtwError::InvalidOption)
+    ));
+}
+
+/// A camera 10 units in front of the identity base's unit square, looking at it.
+fn facing_the_base() -> shadowmap_frustum::Camera {
+    shadowmap_frustum::Camera::look_to(
         Vec3::new(0.5, 0.5, 10.0),
         Vec3::NEG_Z,
         Vec3::Y,
         shadowmap_frustum::Projection::perspective(1.0, 1.0, 0.1, 100.0),
     )
-    .unwrap();
-    assert!(matches!(
-        oracle_needs(&base, &camera, 0.0, &[], |_, _| {}),
-        Err(RtwError::InvalidOption)
-    ));
+    .unwrap()
 }
 
 /// The kept samples' needs are `oracle_needs`' for them, at their own indices; a
@@ -218,13 +223,7 @@ fn oracle_needs_are_the_inverse_jacobian() {
 #[test]
 fn oracle_needs_where_measures_only_the_kept_samples() {
     let base = identity_base();
-    let camera = shadowmap_frustum::Camera::look_to(
-        Vec3::new(0.5, 0.5, 10.0),
-        Vec3::NEG_Z,
-        Vec3::Y,
-        shadowmap_frustum::Projection::perspective(1.0, 1.0, 0.1, 100.0),
-    )
-    .unwrap();
+    let camera = facing_the_base();
     let sample = |x: f32| EyeSample {
         position: Vec3::new(x, 0.5, 0.0),
         normal: Vec3::Z,
