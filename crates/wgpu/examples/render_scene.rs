@@ -3,7 +3,8 @@
 //! `shadowmap::fit`, and the fitted `Shadow` goes to the backend
 //! (`HeadlessRenderer::render_shadow`) with no per-technique code.
 //!
-//! Renders the city block with every technique and writes one PNG per technique to
+//! Renders the city block with every technique (RTW over the lamp's cube faces and
+//! paraboloid included) and writes one PNG per technique to
 //! `rendered/` of the report directory, and beside it the technique's
 //! misclassification against exact stencil shadow volumes at the render resolution:
 //! `<technique>_misclassified.png` (red falsely lit, blue falsely shadowed) and one
@@ -124,7 +125,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         String::from("technique,compared_pixels,false_lit,false_shadowed,misclassification\n");
 
     let mut renderer = HeadlessRenderer::new();
-    for technique in Technique::all_default() {
+    // Every technique of the umbrella crate, and RTW over the lamp's cube faces and
+    // over its IPSM paraboloid (the scene has no spot light).
+    let point_rtw = [
+        Technique::CubeRtw {
+            cube: Default::default(),
+            rtw: Default::default(),
+        },
+        Technique::PointRtw {
+            ipsm: Default::default(),
+            rtw: Default::default(),
+        },
+    ];
+    for technique in Technique::all_default().into_iter().chain(point_rtw) {
         let (light, truth) = match technique.light_kind() {
             LightKind::Directional => (&sun, &sun_exact),
             LightKind::Point => (&lamp, &lamp_exact),
