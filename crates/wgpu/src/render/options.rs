@@ -194,10 +194,11 @@ impl ShadowBias {
     ///                           k = 2   (paraboloid, RTW: their casters are
     ///                                    piecewise-linear approximations)
     /// constant    = 256 (about 1.5e-5 at depth 0.5, in units of 2^(e - 23));
-    ///               16 for cube faces (perspective depth, see below)
+    ///               16 for the perspective depth of cube faces and spot maps
     /// clamp       = 0.01 (nearly edge-on casters, RTW's compressed slivers)
     /// depth       = 1e-4 lookup bias (f32 rounding of the lookup); 2e-7 for cube
-    ///               faces, whose depth near 1 spans d² / near of distance
+    ///               faces and spot maps, whose depth near 1 spans d² / near of
+    ///               distance
     /// world       = 0.05 world units (XPSM only)
     /// ```
     #[must_use]
@@ -221,15 +222,15 @@ impl ShadowBias {
         } else {
             0.0
         };
-        // Cube faces store perspective depth from a near plane that the fit pulls
-        // toward the light (down to 5 cm): there one unit of stored depth spans
+        // Cube faces and spot maps store perspective depth from a near plane close
+        // to the light (a cube's down to 5 cm): there one unit of stored depth spans
         // `d² / near` of distance at distance `d` (1e-4 is 20 m at 100 m), so their
         // constant and lookup biases are a few steps of `f32` depth near 1.
-        let faces = matches!(
-            technique,
-            ShadowTechnique::Cube(_) | ShadowTechnique::CubeRtw { .. }
-        );
-        let (constant, depth) = if faces { (16, 2e-7) } else { (256, 1e-4) };
+        let (constant, depth) = if technique.perspective_depth() {
+            (16, 2e-7)
+        } else {
+            (256, 1e-4)
+        };
         Self::new(
             DepthBias {
                 constant,

@@ -159,6 +159,19 @@ impl ShadowTechnique<'_> {
         }
     }
 
+    /// Whether the technique stores perspective depth seen from a light position
+    /// (cube faces; the spot fit, the spot warps and RTW over the spot fit), whose
+    /// stored-depth units near 1 span a distance growing as its square.
+    pub(super) fn perspective_depth(&self) -> bool {
+        match self {
+            Self::Cube(_) | Self::CubeRtw { .. } => true,
+            Self::Paraboloid(_) | Self::ParaboloidRtw { .. } => false,
+            _ => self
+                .first_transform()
+                .is_some_and(|t| matches!(t.light, LightDirection::Position(_))),
+        }
+    }
+
     pub(super) fn reversed_z(&self) -> bool {
         match self {
             Self::Paraboloid(m) | Self::ParaboloidRtw { map: m, .. } => m.reversed_z,
