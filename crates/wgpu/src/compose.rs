@@ -4,8 +4,8 @@
 //!
 //! - The scene shader (`render_scene.wgsl`) takes a lookup (`lookup_*.wgsl`) and a
 //!   filter (`filter_*.wgsl`): [`compose_scene_shader`].
-//! - RTW's depth pass (`depth_rtw.wgsl`), lookups (`lookup_rtw.wgsl`,
-//!   `lookup_cube_rtw.wgsl`), the caster refinement (`refine.wgsl`) and the
+//! - RTW's depth pass (`depth_rtw.wgsl`), lookup (`lookup_rtw.wgsl`), the caster
+//!   refinement (`refine.wgsl`) and the
 //!   paraboloid depth pass and lookup (warped by RTW over a paraboloid side) take the
 //!   one warp-table sampler of `rtw_sample.wgsl` ([`with_rtw_sample`]), which has the
 //!   semantics of `shadowmap_rtw::sample_table`.
@@ -80,14 +80,6 @@ pub fn lookup_rtw() -> Result<String, BackendError> {
     expand(shaders::LOOKUP_RTW)
 }
 
-/// The lookup of RTW over cube faces with the table sampler composed in.
-///
-/// # Errors
-/// As [`expand`].
-pub fn lookup_cube_rtw() -> Result<String, BackendError> {
-    expand(shaders::LOOKUP_CUBE_RTW)
-}
-
 /// The paraboloid lookup with the projection and the table sampler composed in.
 ///
 /// # Errors
@@ -144,11 +136,6 @@ pub fn composed_shaders() -> Vec<(&'static str, Result<String, BackendError>)> {
         (LOOKUP_RTW, FILTER_PCF),
         (LOOKUP_RTW, FILTER_POISSON),
         (LOOKUP_RTW, FILTER_VSM),
-        (LOOKUP_CUBE_RTW, FILTER_HARD),
-        (LOOKUP_CUBE_RTW, FILTER_HARDWARE),
-        (LOOKUP_CUBE_RTW, FILTER_PCF),
-        (LOOKUP_CUBE_RTW, FILTER_POISSON),
-        (LOOKUP_CUBE_RTW, FILTER_VSM),
     ];
     let mut out: Vec<_> = all
         .iter()
@@ -198,7 +185,6 @@ mod tests {
         for source in [
             depth_rtw().unwrap(),
             lookup_rtw().unwrap(),
-            lookup_cube_rtw().unwrap(),
             refine().unwrap(),
             depth_paraboloid().unwrap(),
             lookup_paraboloid().unwrap(),

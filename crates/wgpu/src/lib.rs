@@ -239,13 +239,10 @@ pub mod shaders {
     /// shared functions are placeholders until composed
     /// ([`crate::compose::lookup_paraboloid`]).
     pub const LOOKUP_PARABOLOID: &str = include_str!("../shaders/lookup_paraboloid.wgsl");
-    /// Lookup of RTW (base projection, warp tables); its table sampler is a
+    /// Lookup of RTW over one base or each kept cube face (base projection, warp
+    /// tables, the layer's corner); its table sampler is a
     /// placeholder until composed ([`crate::compose::lookup_rtw`]).
     pub const LOOKUP_RTW: &str = include_str!("../shaders/lookup_rtw.wgsl");
-    /// Lookup of RTW over the kept faces of a cube map (face by projection, its warp
-    /// tables, its layer's corner); its table sampler is a placeholder until composed
-    /// ([`crate::compose::lookup_cube_rtw`]).
-    pub const LOOKUP_CUBE_RTW: &str = include_str!("../shaders/lookup_cube_rtw.wgsl");
     /// The RTW warp-table sampler, composed into the RTW depth pass and lookup.
     pub const RTW_SAMPLE: &str = include_str!("../shaders/rtw_sample.wgsl");
     /// Filter: one nearest texel.

@@ -460,20 +460,32 @@ impl RtwShadowRaw {
     }
 }
 
-/// Most faces of a cube map (layers of [`WarpedCubeLookupRaw`]).
-pub const CUBE_FACES: usize = 6;
+/// Most bases of [`RtwLookupRaw`]: the faces of a cube map.
+pub const RTW_LOOKUP_BASES: usize = 6;
 
-/// The lookup of RTW over the kept faces of a cube map (`cube_rtw`): WGSL
-/// `WarpedCube`. A point is looked up in the first face whose window holds it (the
+/// The lookup of RTW: WGSL `RtwLookup`. Over one base (the uniform or the spot fit,
+/// [`RtwLookupRaw::one`]) every point is looked up in it; over several (the kept
+/// faces of a cube map, [`warped_cube`]) in the first whose window holds it (the
 /// windows are disjoint up to rounding, as the cube lookup selects), then warped
-/// through that face's tables and scaled into its layer's corner.
+/// through that base's tables and scaled into its layer's corner.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct WarpedCubeLookupRaw {
-    /// One block per kept face, in layer order (unused entries zero).
-    pub faces: [RtwShadowRaw; CUBE_FACES],
-    /// `x`: kept faces; `y`, `z`, `w`: 0.
+pub struct RtwLookupRaw {
+    /// One block per base, in layer order (unused entries zero).
+    pub bases: [RtwShadowRaw; RTW_LOOKUP_BASES],
+    /// `x`: bases in use; `y`, `z`, `w`: 0.
     pub count: [u32; 4],
+}
+
+impl RtwLookupRaw {
+    /// The lookup of one base.
+    #[must_use]
+    pub fn one(base: RtwShadowRaw) -> Self {
+        let mut raw = Self::zeroed();
+        raw.bases[0] = base;
+        raw.count[0] = 1;
+        raw
+    }
 }
 
 /// RTW over the kept faces of a cube map (`cube_rtw`): the depth pass's blocks, the
@@ -483,7 +495,7 @@ pub struct WarpedCube {
     /// One block per kept face (its perspective base, tables and corner).
     pub layers: Vec<RtwShadowRaw>,
     /// The lookup.
-    pub lookup: WarpedCubeLookupRaw,
+    pub lookup: RtwLookupRaw,
     /// The tables: face 0's `u` then `v`, face 1's, ... (one zero when there are
     /// none).
     pub tables: Vec<f32>,
@@ -517,11 +529,11 @@ pub fn warped_cube(cube: &CubeMap, warps: &[WarpMaps]) -> WarpedCube {
     if tables.is_empty() {
         tables.push(0.0);
     }
-    let mut lookup = WarpedCubeLookupRaw::zeroed();
-    for (slot, raw) in lookup.faces.iter_mut().zip(&layers) {
+    let mut lookup = RtwLookupRaw::zeroed();
+    for (slot, raw) in lookup.bases.iter_mut().zip(&layers) {
         *slot = *raw;
     }
-    lookup.count[0] = layers.len().min(CUBE_FACES) as u32;
+    lookup.count[0] = layers.len().min(RTW_LOOKUP_BASES) as u32;
     WarpedCube {
         layers,
         lookup,

@@ -87,7 +87,7 @@ fn composed_sources() -> Vec<(&'static str, Result<String, shadowmap_wgpu::Backe
 
 /// Lookups times filters the renderer composes, the RTW and paraboloid depth passes
 /// and the refinement.
-const COMPOSITIONS: usize = 5 * 5 + 3;
+const COMPOSITIONS: usize = 4 * 5 + 3;
 
 #[test]
 fn every_shader_file_parses_and_validates() {

@@ -13,8 +13,7 @@ use shadowmap::{CascadePlan, DpsmOptions, FitInput, Fitted, Technique, fit};
 use shadowmap_wgpu::shaders;
 use shadowmap_wgpu::uniforms::{
     CascadeShadowRaw, FrameRaw, MatrixShadowRaw, ParaboloidLayerRaw, ParaboloidLookupRaw,
-    RtwShadowRaw, ToRaw, WarpedCubeLookupRaw, cascade_layers, paraboloid_layers,
-    warped_cascade_layers,
+    RtwLookupRaw, RtwShadowRaw, ToRaw, cascade_layers, paraboloid_layers, warped_cascade_layers,
 };
 
 /// (struct span, member offsets) of `name` in `source`, by naga's layouter.
@@ -150,20 +149,16 @@ fn rtw_and_frame_blocks_match() {
         ("table_offsets", offset_of!(RtwShadowRaw, table_offsets)),
         ("layer", offset_of!(RtwShadowRaw, layer)),
     ];
-    for source in [
-        shaders::DEPTH_RTW,
-        shaders::LOOKUP_RTW,
-        shaders::LOOKUP_CUBE_RTW,
-    ] {
+    for source in [shaders::DEPTH_RTW, shaders::LOOKUP_RTW] {
         check(source, "RtwShadow", size_of::<RtwShadowRaw>(), &rtw);
     }
     check(
-        shaders::LOOKUP_CUBE_RTW,
-        "WarpedCube",
-        size_of::<WarpedCubeLookupRaw>(),
+        shaders::LOOKUP_RTW,
+        "RtwLookup",
+        size_of::<RtwLookupRaw>(),
         &[
-            ("faces", offset_of!(WarpedCubeLookupRaw, faces)),
-            ("count", offset_of!(WarpedCubeLookupRaw, count)),
+            ("bases", offset_of!(RtwLookupRaw, bases)),
+            ("count", offset_of!(RtwLookupRaw, count)),
         ],
     );
     check(

@@ -9,8 +9,8 @@ use shadowmap_warp::{WarpedCascades, XpsmShadow};
 
 use crate::rtw::GpuRtw;
 use crate::uniforms::{
-    CascadeShadowRaw, MatrixShadowRaw, ParaboloidLookupRaw, RtwShadowRaw, ToRaw, cascade_layers,
-    cube_layers, warped_cascade_layers, warped_cube, warped_paraboloid,
+    CascadeShadowRaw, MatrixShadowRaw, ParaboloidLookupRaw, RtwLookupRaw, RtwShadowRaw, ToRaw,
+    cascade_layers, cube_layers, warped_cascade_layers, warped_cube, warped_paraboloid,
 };
 use crate::{BackendError, compose, shaders};
 
@@ -85,7 +85,6 @@ pub(super) enum Lookup {
     Cascades,
     Paraboloid,
     Rtw,
-    CubeRtw,
 }
 
 impl Lookup {
@@ -96,7 +95,6 @@ impl Lookup {
             Self::Cascades => Ok(shaders::LOOKUP_CASCADES.to_owned()),
             Self::Paraboloid => compose::lookup_paraboloid(),
             Self::Rtw => compose::lookup_rtw(),
-            Self::CubeRtw => compose::lookup_cube_rtw(),
         }
     }
 }
@@ -110,8 +108,7 @@ impl ShadowTechnique<'_> {
             | Self::WarpedCascades(_)
             | Self::Cube(_) => Lookup::Cascades,
             Self::Paraboloid(_) | Self::ParaboloidRtw { .. } => Lookup::Paraboloid,
-            Self::Rtw(_) | Self::RtwGpu { .. } => Lookup::Rtw,
-            Self::CubeRtw { .. } => Lookup::CubeRtw,
+            Self::Rtw(_) | Self::RtwGpu { .. } | Self::CubeRtw { .. } => Lookup::Rtw,
         }
     }
 
@@ -220,11 +217,11 @@ impl ShadowTechnique<'_> {
             Self::CubeRtw { cube, warps } => {
                 bytemuck::bytes_of(&warped_cube(cube, warps).lookup).to_vec()
             }
-            Self::Rtw(r) => bytemuck::bytes_of(&r.to_raw()).to_vec(),
-            Self::RtwGpu { base, rtw } => {
-                bytemuck::bytes_of(&RtwShadowRaw::from_base(base, rtw.width(), rtw.height()))
-                    .to_vec()
-            }
+            Self::Rtw(r) => bytemuck::bytes_of(&RtwLookupRaw::one(r.to_raw())).to_vec(),
+            Self::RtwGpu { base, rtw } => bytemuck::bytes_of(&RtwLookupRaw::one(
+                RtwShadowRaw::from_base(base, rtw.width(), rtw.height()),
+            ))
+            .to_vec(),
         }
     }
 }
