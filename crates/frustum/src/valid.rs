@@ -91,6 +91,27 @@ impl ValidCamera {
         self.geometry.slice(n, f)
     }
 
+    /// The corners of [`ValidCamera::slice`] (near then far; bottom-left,
+    /// bottom-right, top-right, top-left) without its planes, for a builder that
+    /// reads only the corners.
+    ///
+    /// # Errors
+    /// As [`ValidCamera::slice`] for the depth pair; [`FrustumError::NonFinite`]
+    /// when a corner overflows `f32`.
+    pub fn slice_corners(
+        &self,
+        near_depth: f32,
+        far_depth: f32,
+    ) -> Result<[Vec3; 8], FrustumError> {
+        let (n, f) = self.geometry.check_slice(near_depth, far_depth)?;
+        let corners = self.geometry.world_corners(n, f).map(glam::DVec3::as_vec3);
+        if corners.iter().all(|c| c.is_finite()) {
+            Ok(corners)
+        } else {
+            Err(FrustumError::NonFinite)
+        }
+    }
+
     /// Near and far view depth over which shadows are computed, as
     /// [`Camera::depth_range`].
     #[must_use]

@@ -5,7 +5,7 @@ use glam::{DQuat, DVec3, Mat4, Quat, Vec3};
 use proptest::prelude::*;
 use shadowmap_frustum::{
     Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, ConvexBody, SceneBounds,
-    SplitScheme,
+    SplitScheme, ValidCamera,
 };
 use shadowmap_testgen::{
     GenResult, arbitrary::Unstructured, camera, frustum as cases, in_range, light_direction,
@@ -98,6 +98,24 @@ proptest! {
                 prop_assert!(s.uv.y >= -tv && s.uv.y <= 1.0 + tv, "cascade {i}: v = {} (tol {tv})", s.uv.y);
                 prop_assert!(s.depth >= -tz && s.depth <= 1.0 + tz, "cascade {i}: depth = {} (tol {tz})", s.depth);
             }
+        }
+    }
+
+    /// A checked camera's slice corners without the planes are the slice's corners
+    /// (`ValidCamera::slice_corners`, which the IPSM plan reads), and refuse the
+    /// same depth pairs.
+    #[test]
+    fn slice_corners_are_the_slice_corners(
+        (camera, a, b) in strategy(|u| Ok((camera(u)?, in_range(u, 0.0, 1.0)?, in_range(u, 0.0, 1.0)?)))
+    ) {
+        let Ok(valid) = ValidCamera::new(&camera) else { return Ok(()) };
+        let (near, far) = valid.depth_range();
+        let depth = |t: f32| near + (far - near) * t;
+        let (n, f) = (depth(a.min(b)), depth(a.max(b)));
+        match (valid.slice(n, f), valid.slice_corners(n, f)) {
+            (Ok(slice), Ok(corners)) => prop_assert_eq!(slice.corners, corners),
+            (Err(e), Err(c)) => prop_assert_eq!(e, c),
+            (slice, corners) => prop_assert!(false, "{:?} vs {:?}", slice, corners),
         }
     }
 

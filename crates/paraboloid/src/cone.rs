@@ -81,10 +81,7 @@ impl DCone {
     pub(crate) fn to_f32(self, dirs: &[DVec3]) -> Cone {
         let axis32 = self.axis.as_vec3().normalize_or(Vec3::NEG_Z);
         let axis = axis32.as_dvec3();
-        let half = dirs
-            .iter()
-            .map(|&d| angle_between(axis, d))
-            .fold(self.half_angle, f64::max);
+        let half = max_angle(axis, dirs).max(self.half_angle);
         Cone {
             axis: axis32,
             half_angle: round_up_f32(half).min(core::f32::consts::PI),
@@ -109,11 +106,38 @@ fn next_up(x: f32) -> f32 {
     f32::from_bits(if x > 0.0 { bits + 1 } else { bits - 1 })
 }
 
-/// The largest angle from `axis` to any direction.
-fn max_angle(axis: DVec3, dirs: &[DVec3]) -> f64 {
-    dirs.iter()
-        .map(|&d| angle_between(axis, d))
-        .fold(0.0, f64::max)
+/// The largest angle from `axis` to any direction (0 for none): the largest
+/// [`angle_between`], with one `atan2` for the widest direction rather than one per
+/// direction.
+///
+/// The angle of `(y, x) = (|a × d|, a · d)` grows with `y x' - x y'` against any other
+/// pair `(y', x')` (both angles lie in `[0, pi]`), so one pass keeps the widest
+/// direction by comparing those products. A direction the products cannot order
+/// beyond doubt against the widest so far (a product within a relative `1e-9` of
+/// zero, where rounding could order the two either way, or angles 0 and `pi`) gets
+/// its own `atan2`. The widest direction is then either the one kept (each
+/// replacement is wider beyond doubt) or one of those, so the result is exactly
+/// the maximum of the per-direction angles.
+pub(crate) fn max_angle(axis: DVec3, dirs: &[DVec3]) -> f64 {
+    let mut widest: Option<(f64, f64)> = None;
+    let mut tied = 0.0f64;
+    for d in dirs {
+        let p = (axis.cross(*d).length(), axis.dot(*d));
+        let Some(w) = widest else {
+            widest = Some(p);
+            continue;
+        };
+        let (a, b) = (p.0 * w.1, w.0 * p.1);
+        let gap = a - b;
+        if gap.abs() > 1e-9 * (a.abs() + b.abs()) {
+            if gap > 0.0 {
+                widest = Some(p);
+            }
+        } else if p != w {
+            tied = tied.max(math::atan2(p.0, p.1));
+        }
+    }
+    widest.map_or(0.0, |w| math::atan2(w.0, w.1).max(tied).max(0.0))
 }
 
 /// The paper's fit on unit directions; `None` when their sum (nearly) vanishes.
@@ -546,6 +570,22 @@ mod tests {
                 (Some(c), None) | (None, Some(c)) => {
                     prop_assert!(c.half_angle > NO_CONE_ANGLE - 1e-6, "{c:?}");
                 }
+            }
+        }
+
+        /// The widest direction found by comparing products, then one `atan2`,
+        /// gives exactly the largest angle of every direction, about the fitted
+        /// axis and about one of the directions (many ties at 0).
+        #[test]
+        fn max_angle_is_the_largest_angle_between(dirs in strategy(cone_directions)) {
+            let Ok(dirs) = unit_directions(&dirs) else { return Ok(()) };
+            let sum: DVec3 = dirs.iter().copied().sum();
+            for axis in [sum.normalize_or(DVec3::Z), dirs[0], -dirs[0]] {
+                let each = dirs
+                    .iter()
+                    .map(|&d| angle_between(axis, d))
+                    .fold(0.0, f64::max);
+                prop_assert_eq!(max_angle(axis, &dirs), each);
             }
         }
     }

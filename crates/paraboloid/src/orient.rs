@@ -102,23 +102,31 @@ pub(crate) fn dual_axis(
     toward: DVec3,
     fallback: DVec3,
 ) -> DVec3 {
-    dual_axis_below(l, pts, up_hint, toward, fallback, f64::INFINITY)
+    dual_axis_below(&samples(l, pts), up_hint, toward, fallback, f64::INFINITY)
         .unwrap_or_else(|| facing(fallback, toward, up_hint))
 }
 
-/// [`dual_axis`] where its [`cost`] is below `bound`, else `None`. The search
-/// starts from the bound, so a candidate stops being costed once it reaches it:
-/// deciding between one cut paraboloid and a dual map ([`single_cost`]) costs less
-/// than finding the dual map's axis.
+/// [`dual_axis`] where its [`cost`] is below `bound`, else `None`, from the
+/// [`samples`] of the light and the frustum. The search starts from the bound, so
+/// a candidate stops being costed once it reaches it: deciding between one cut
+/// paraboloid and a dual map ([`single_cost`]) costs less than finding the dual
+/// map's axis.
 pub(crate) fn dual_axis_below(
-    l: DVec3,
-    pts: &[DVec3; 8],
+    samples: &[Sample],
     up_hint: DVec3,
     toward: DVec3,
     fallback: DVec3,
     bound: f64,
 ) -> Option<DVec3> {
-    let samples = samples(l, pts);
+    // Every axis costs at least `max_i |v_i| / s_i` (its `|a . v_i|` term is not
+    // negative): when that reaches the bound, no candidate can beat it.
+    let floor = samples
+        .iter()
+        .map(|s| s.length * s.inv_size)
+        .fold(0.0, f64::max);
+    if !(floor < bound) {
+        return None;
+    }
     let mut best = None;
     let mut best_cost = bound;
     let mut usable = false;
@@ -128,7 +136,7 @@ pub(crate) fn dual_axis_below(
         };
         usable = true;
         // The running maximum only grows: stop once it cannot win.
-        let c = cost_below(a, &samples, best_cost);
+        let c = cost_below(a, samples, best_cost);
         if c < best_cost {
             best_cost = c;
             best = Some(a);
@@ -147,7 +155,7 @@ pub(crate) fn dual_axis_below(
     // Without any usable candidate, the fallback (if it beats the bound).
     let best = match best {
         Some(a) => a,
-        None if !usable && cost_below(fallback, &samples, bound) < bound => fallback,
+        None if !usable && cost_below(fallback, samples, bound) < bound => fallback,
         None => return None,
     };
     Some(facing(best, toward, up_hint))
@@ -169,8 +177,8 @@ fn facing(axis: DVec3, toward: DVec3, up_hint: DVec3) -> DVec3 {
 const SINGLE_SIDE_GAIN: f64 = core::f64::consts::SQRT_2;
 
 /// The predicted cost of one cut paraboloid (front axis the cone's, cut to the cone
-/// widened by `margin`: `zoom = tan((half_angle + margin) / 2)`) over the truncated
-/// frustum `pts`, comparable with a dual map's [`cost`] at the same texel budget: the
+/// widened by `margin`: `zoom = tan((half_angle + margin) / 2)`) over the
+/// [`samples`] of the truncated frustum, comparable with a dual map's [`cost`] at the same texel budget: the
 /// cut map samples at least as finely as the dual map unless that map's cost is
 /// below it ([`dual_axis_below`]). A cut map's texel at angle `theta` from its
 /// axis spans `zoom (1 + cos theta)` times what a dual map's spans at its centre, and
@@ -180,9 +188,9 @@ const SINGLE_SIDE_GAIN: f64 = core::f64::consts::SQRT_2;
 /// single: max_i zoom (|v_i| + a . v_i) / s_i / sqrt(2)
 /// dual:   max_i (|v_i| + |a' . v_i|) / s_i          (the cost of `dual_axis`)
 /// ```
-pub(crate) fn single_cost(l: DVec3, pts: &[DVec3; 8], cone: DCone, margin: f64) -> f64 {
+pub(crate) fn single_cost(samples: &[Sample], cone: DCone, margin: f64) -> f64 {
     let (axis, zoom) = (cone.axis, zoom_for_half_angle(cone.half_angle + margin));
-    samples(l, pts)
+    samples
         .iter()
         .map(|s| zoom * (s.length + axis.dot(s.v)) * s.inv_size)
         .fold(0.0, f64::max)

@@ -8,7 +8,7 @@ use crate::cone::{
     Cone, ConeFit, DCone, MIN_ZOOM, minimal_fit, paper_fit, round_up_f32, zoom_for_half_angle,
 };
 use crate::map::{MapOptions, ParaboloidMap, ParaboloidMode, Side, check_depth_range};
-use crate::orient::{dual_axis, dual_axis_below, single_cost};
+use crate::orient::{dual_axis, dual_axis_below, samples, single_cost};
 
 /// Knobs of [`IpsmPlan`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -202,9 +202,8 @@ impl IpsmPlan {
             Some(b) => b.clamped_to_valid(&valid),
             None => valid.depth_range(),
         };
-        let frustum = valid.slice(lo, hi)?;
-        let mut plan =
-            Self::from_points(position, range, &frustum.corners, camera.forward(), options)?;
+        let corners = valid.slice_corners(lo, hi)?;
+        let mut plan = Self::from_points(position, range, &corners, camera.forward(), options)?;
         plan.depth_range = (lo, hi);
         Ok(plan)
     }
@@ -297,8 +296,9 @@ impl IpsmPlan {
             (None, Some(c)) if c.half_angle + margin >= max_single => Some(DualReason::ConeTooWide),
             (None, Some(c)) => {
                 // The dual map wins where some axis costs less than the cut map.
-                let single = single_cost(l, &pts, c, margin);
-                dual_axis_below(l, &pts, up_hint, fallback_axis, fallback_axis, single).map(
+                let samples = samples(l, &pts);
+                let single = single_cost(&samples, c, margin);
+                dual_axis_below(&samples, up_hint, fallback_axis, fallback_axis, single).map(
                     |axis| {
                         dual_found.set(Some(axis));
                         DualReason::DualFiner
