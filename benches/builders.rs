@@ -115,8 +115,17 @@ fn frame() -> Frame {
     }
 }
 
+/// What the builders that refit in place write into, kept across calls as a renderer
+/// keeps them across frames.
+struct Outputs {
+    /// RTW warp tables.
+    warps: WarpMaps,
+    /// One light's cascades.
+    set: CascadeSet,
+}
+
 /// The builders, by name.
-const NAMES: [&str; 21] = [
+const NAMES: [&str; 23] = [
     "bevy_cascades_4",
     "uniform_focused",
     "stable_cascades_4",
@@ -138,6 +147,8 @@ const NAMES: [&str; 21] = [
     "lispsm_from_body",
     "xpsm_from_body",
     "tsm_from_body",
+    "stable_cascades_4_refit",
+    "tight_cascades_4_refit",
 ];
 
 /// Keeps a builder's result where it was returned (the output is not moved out of
@@ -147,8 +158,10 @@ fn keep<T, E: core::fmt::Debug>(result: &Result<T, E>) {
     black_box(result.as_ref().expect("builder failed"));
 }
 
-/// Runs builder `which` once on `f` (`warps` is the RTW output buffer).
-fn run(f: &Frame, warps: &mut WarpMaps, which: usize) {
+/// Runs builder `which` once on `f` (`out` holds the outputs refitted in place: the
+/// RTW tables and a cascade set).
+fn run(f: &Frame, out: &mut Outputs, which: usize) {
+    let warps = &mut out.warps;
     let cam = black_box(&f.camera);
     let light = black_box(f.light);
     match which {
@@ -243,6 +256,12 @@ fn run(f: &Frame, warps: &mut WarpMaps, which: usize) {
         20 => {
             keep(&black_box(&f.body).tsm(&TsmOptions::default()));
         }
+        21 | 22 => {
+            let options = if which == 21 { &f.stable } else { &f.tight };
+            let fitted = out.set.refit_valid(&f.valid, light, &f.splits, options);
+            keep(&fitted);
+            black_box(&out.set);
+        }
         _ => unreachable!("no builder {which}"),
     }
 }
@@ -251,7 +270,7 @@ fn run(f: &Frame, warps: &mut WarpMaps, which: usize) {
 /// builder `n` times and times nothing: run under `valgrind --tool=callgrind` with two
 /// values of `n`, the difference of the instruction counts divided by the difference
 /// of `n` is the builder's instructions per call, repeatable on a loaded machine.
-fn only(f: &Frame, warps: &mut WarpMaps) -> bool {
+fn only(f: &Frame, out: &mut Outputs) -> bool {
     let Ok(name) = std::env::var("BUILDERS_ONLY") else {
         return false;
     };
@@ -264,7 +283,7 @@ fn only(f: &Frame, warps: &mut WarpMaps) -> bool {
         .position(|n| *n == name)
         .unwrap_or_else(|| panic!("BUILDERS_ONLY: no builder {name}; one of {NAMES:?}"));
     for _ in 0..calls {
-        run(f, warps, which);
+        run(f, out, which);
     }
     true
 }
@@ -272,25 +291,28 @@ fn only(f: &Frame, warps: &mut WarpMaps) -> bool {
 #[allow(clippy::print_stdout)] // The table is this bench's output.
 fn builders(c: &mut Criterion) {
     let f = frame();
-    let mut warps = WarpMaps::new(1024, 1).unwrap();
-    if only(&f, &mut warps) {
+    let mut out = Outputs {
+        warps: WarpMaps::new(1024, 1).unwrap(),
+        set: CascadeSet::fit_valid(&f.valid, f.light, &f.splits, &f.stable).unwrap(),
+    };
+    if only(&f, &mut out) {
         return;
     }
     let mut g = c.benchmark_group("builders");
     g.warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(1));
     for (i, name) in NAMES.iter().enumerate() {
-        g.bench_function(*name, |b| b.iter(|| run(&f, &mut warps, i)));
+        g.bench_function(*name, |b| b.iter(|| run(&f, &mut out, i)));
     }
     g.finish();
 
-    let bevy = timing::min_ns(|| run(&f, &mut warps, 0));
+    let bevy = timing::min_ns(|| run(&f, &mut out, 0));
     println!("builders, one run (time per call, fastest of 201 batches):");
     for (i, name) in NAMES.iter().enumerate() {
         let t = if i == 0 {
             bevy
         } else {
-            timing::min_ns(|| run(&f, &mut warps, i))
+            timing::min_ns(|| run(&f, &mut out, i))
         };
         println!(
             "  {name:<22} {:>9.3} us  {:>7.2}x bevy_cascades_4",

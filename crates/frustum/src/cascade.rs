@@ -211,6 +211,47 @@ impl CascadeSet {
         Self::fit_inner(camera, light_direction, splits, options, None)
     }
 
+    /// [`CascadeSet::fit_valid`] into this set, in place: what a renderer that keeps
+    /// one set per light and refits it every frame calls, without moving a new set
+    /// (it holds room for [`MAX_CASCADES`] cascades) out of a `Result` into its
+    /// place. The same cascades as [`CascadeSet::fit_valid`].
+    ///
+    /// ```
+    /// use glam::Vec3;
+    /// use shadowmap_frustum::{Camera, CascadeOptions, CascadeSet, CascadeSplits, Projection,
+    ///     SplitScheme, ValidCamera};
+    ///
+    /// let camera = Camera::look_to(Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Z, Vec3::Y,
+    ///     Projection::perspective(1.0, 1.5, 0.1, 200.0))?;
+    /// let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.5 }, 4, 0.1, 200.0)?;
+    /// let (sun, options) = (Vec3::new(0.3, -1.0, 0.2), CascadeOptions::default());
+    /// let valid = ValidCamera::new(&camera)?;
+    /// let mut set = CascadeSet::fit_valid(&valid, sun, &splits, &options)?; // first frame
+    /// set.refit_valid(&valid, sun, &splits, &options)?; // every later frame
+    /// assert_eq!(set, CascadeSet::fit_valid(&valid, sun, &splits, &options)?);
+    /// # Ok::<(), shadowmap_frustum::FrustumError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`CascadeSet::fit_valid`]; the set is then left without cascades.
+    pub fn refit_valid(
+        &mut self,
+        camera: &ValidCamera,
+        light_direction: Vec3,
+        splits: &CascadeSplits,
+        options: &CascadeOptions,
+    ) -> Result<(), FrustumError> {
+        self.cascades.clear();
+        self.splits.clone_from(splits);
+        self.view_from_world = camera.geometry.view_from_world32;
+        self.resolution = options.resolution;
+        let fitted = self.fill(camera, light_direction, options, None);
+        if fitted.is_err() {
+            self.cascades.clear();
+        }
+        fitted
+    }
+
     /// As [`CascadeSet::fit_valid`], with the stable fit's sizes held across frames
     /// in `state` (see [`CascadeState`]): with [`CascadeFit::Stable`] and scene
     /// bounds, each cascade's box is fitted to its slice ∩ receivers and keeps its

@@ -7,7 +7,7 @@ use std::alloc::System;
 use glam::Vec3;
 use shadowmap_frustum::{
     Aabb, Camera, CascadeOptions, CascadeSet, CascadeSplits, ConvexBody, Light, Projection,
-    SceneBounds, SplitScheme, fit_spot,
+    SceneBounds, SplitScheme, ValidCamera, fit_spot,
 };
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
 
@@ -37,6 +37,9 @@ fn per_frame_path_does_not_allocate() {
         range: 60.0,
     };
 
+    // A set a renderer keeps and refits in place every frame.
+    let first = CascadeSplits::new(&SplitScheme::Practical { lambda: 0.5 }, 2, 0.1, 300.0).unwrap();
+    let mut refitted = CascadeSet::fit(&camera, light, &first, &options).unwrap();
     let region = Region::new(GLOBAL);
     let mut checksum = 0.0f32;
     for frame in 0..10 {
@@ -48,6 +51,11 @@ fn per_frame_path_does_not_allocate() {
         let splits =
             CascadeSplits::new(&SplitScheme::Practical { lambda: 0.5 }, 4, 0.1, 300.0).unwrap();
         let set = CascadeSet::fit(&camera, light, &splits, &options).unwrap();
+        let valid = ValidCamera::new(&camera).unwrap();
+        refitted
+            .refit_valid(&valid, light, &splits, &options)
+            .unwrap();
+        assert_eq!(refitted, set);
         let frustum = camera.frustum().unwrap();
         let body = ConvexBody::from_frustum_aabb(&frustum, &ground).unwrap();
         let extruded = body.extruded_toward_light(light, &scene.casters).unwrap();
