@@ -6,7 +6,8 @@
 //! cascade fits and the four single-frustum warps also from a camera validated once
 //! per frame (`ValidCamera`), and the focus body alone with each warp fitted from a
 //! body built once (`FocusBody`: what a frame pays per technique once the body is
-//! shared). Besides criterion's figures it prints one table: each
+//! shared), and the 4-cascade fits refitted in place into a set kept across calls
+//! (`CascadeSet::refit_valid`). Besides criterion's figures it prints one table: each
 //! builder's time per call (the fastest of many short batches, see
 //! `support/timing.rs`) and its ratio to Bevy's 4 cascades. `BUILDERS_ONLY` runs one
 //! builder for instruction counting (see `only`).
