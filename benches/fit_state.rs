@@ -3,7 +3,8 @@
 //! count chosen from the predicted error, and `auto`, which fits and predicts all
 //! seven candidates; each beside the uniform fit timed in the same run. Besides
 //! criterion's figures it prints each fit's time per call (the fastest of many short
-//! batches, see `support/timing.rs`) and its ratio to the uniform fit.
+//! batches, see `support/timing.rs`) and its ratio to the uniform fit. `FIT_STATE_ONLY`
+//! runs one fit for instruction counting (see `only`).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
@@ -39,6 +40,30 @@ fn frame() -> (Camera, Light, SceneBounds, DepthBounds) {
     (camera, light, SceneBounds::new(ground, casters), bounds)
 }
 
+/// With `FIT_STATE_ONLY=<name>` (and `FIT_STATE_CALLS=<n>`, default 1), fits that
+/// technique `n` times and times nothing: run under `valgrind --tool=callgrind` with
+/// two values of `n`, the difference of the instruction counts divided by the
+/// difference of `n` is the fit's instructions per frame, repeatable on a loaded
+/// machine.
+fn only(techniques: &[(&str, Technique)], input: &FitInput<'_>) -> bool {
+    let Ok(name) = std::env::var("FIT_STATE_ONLY") else {
+        return false;
+    };
+    let calls: usize = std::env::var("FIT_STATE_CALLS")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(1);
+    let (_, technique) = techniques
+        .iter()
+        .find(|(n, _)| *n == name)
+        .unwrap_or_else(|| panic!("FIT_STATE_ONLY: no fit {name}"));
+    let mut state = FitState::default();
+    for _ in 0..calls {
+        black_box(fit_with_state(technique, input, &mut state).is_ok());
+    }
+    true
+}
+
 #[allow(clippy::print_stdout)] // The table is this bench's output.
 fn fits(c: &mut Criterion) {
     let (camera, light, scene, bounds) = frame();
@@ -57,6 +82,9 @@ fn fits(c: &mut Criterion) {
         ),
         ("auto", Technique::Auto(plan)),
     ];
+    if only(&techniques, &input) {
+        return;
+    }
     let mut group = c.benchmark_group("fit_with_state");
     for (name, technique) in &techniques {
         let mut state = FitState::default();
