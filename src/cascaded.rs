@@ -2,7 +2,7 @@
 //! cascades, their count from the predicted error, and their light frame.
 
 use arrayvec::ArrayVec;
-use glam::{DVec3, Vec3};
+use glam::{DVec2, DVec3, Vec3};
 use shadowmap_frustum::{
     Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, MAX_CASCADES,
     MAX_PREDICT_CANDIDATES, ShadowMapping, ShadowSample, SplitScheme, ValidCamera,
@@ -185,6 +185,15 @@ impl ShadowMapping for Candidate {
         match self {
             Self::Cascades(set) => set.map_point(world),
             Self::Warped(cascades, eye, forward) => cascades.view(*eye, *forward).map_point(world),
+        }
+    }
+
+    fn uv_differentials(&self, centre: DVec3, around: &[DVec3; 4]) -> Option<[DVec2; 2]> {
+        match self {
+            Self::Cascades(set) => set.uv_differentials(centre, around),
+            Self::Warped(cascades, eye, forward) => cascades
+                .view(*eye, *forward)
+                .uv_differentials(centre, around),
         }
     }
 }

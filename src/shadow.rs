@@ -2,8 +2,11 @@
 
 use alloc::vec::Vec;
 
-use glam::{DVec3, Vec3};
-use shadowmap_frustum::{CascadeSet, ShadowMapping, ShadowSample, ShadowTransform, SpotShadow};
+use glam::{DVec2, DVec3, Vec3};
+use shadowmap_frustum::{
+    CascadeSet, ShadowMapping, ShadowSample, ShadowTransform, SpotShadow,
+    uv_differentials_by_points,
+};
 use shadowmap_paraboloid::{CubeMap, IpsmPlan, ParaboloidMap};
 use shadowmap_rtw::{RtwShadow, WarpMaps};
 use shadowmap_warp::{
@@ -290,6 +293,30 @@ impl ShadowMapping for Shadow {
             | Fitted::Tsm(TsmShadow { transform, .. })
             | Fitted::Spot(SpotShadow { transform, .. })
             | Fitted::SpotWarp(SpotWarpShadow { transform, .. }) => transform.map_point(world),
+        }
+    }
+
+    /// The fitted technique's own differentials (the derivative of its matrix, for
+    /// the matrix techniques).
+    fn uv_differentials(&self, centre: DVec3, around: &[DVec3; 4]) -> Option<[DVec2; 2]> {
+        match &self.fitted {
+            Fitted::Cascades(set) => set.uv_differentials(centre, around),
+            Fitted::WarpedCascades {
+                cascades,
+                eye,
+                forward,
+            } => cascades
+                .view(*eye, *forward)
+                .uv_differentials(centre, around),
+            Fitted::Uniform(t) => t.uv_differentials(centre, around),
+            Fitted::Lispsm(LispsmShadow { transform, .. })
+            | Fitted::Xpsm(XpsmShadow { transform, .. })
+            | Fitted::Tsm(TsmShadow { transform, .. })
+            | Fitted::Spot(SpotShadow { transform, .. })
+            | Fitted::SpotWarp(SpotWarpShadow { transform, .. }) => {
+                transform.uv_differentials(centre, around)
+            }
+            _ => uv_differentials_by_points(self, centre, around),
         }
     }
 }

@@ -23,7 +23,7 @@
 //! counted (the metrics count the faces' own texels). A technique that cannot handle a frame returns
 //! [`EvalError::Technique`] with the math crate's reason, never panics.
 
-use glam::{DMat4, DVec3, DVec4, Vec3};
+use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
 use shadowmap::paraboloid::{
     ConeFit, CubeMap, CubeOptions, FaceSizes, IpsmOptions, Side, SubdivisionOptions,
     subdivide_triangles,
@@ -651,5 +651,9 @@ impl<P: DepthProjector> DepthProjector for OneLayer<P> {
 impl ShadowMapping for Technique {
     fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
         self.shadow.map_point(world)
+    }
+
+    fn uv_differentials(&self, centre: DVec3, around: &[DVec3; 4]) -> Option<[DVec2; 2]> {
+        self.shadow.uv_differentials(centre, around)
     }
 }

@@ -7,7 +7,9 @@ use crate::camera::CameraGeometry;
 use crate::cascade_state::{CascadeState, HeldSlot, held_box};
 use crate::light::unit;
 use crate::light_prism::LightPrism;
-use crate::mapping::{LightDirection, ShadowSample, ShadowTransform, project_dmat};
+use crate::mapping::{
+    LightDirection, ShadowSample, ShadowTransform, project_dmat, projective_uv_differentials,
+};
 use crate::rays::Rays;
 use crate::split::CascadeBlend;
 use crate::{
@@ -364,6 +366,19 @@ impl ShadowMapping for CascadeSet {
         let mut s = project_dmat(&cascade.transform.uv_from_world.as_dmat4(), world)?;
         s.layer = blend.index as u32;
         Some(s)
+    }
+
+    /// Every point selected by view depth, all in one cascade; that cascade's
+    /// derivative.
+    fn uv_differentials(&self, centre: DVec3, around: &[DVec3; 4]) -> Option<[DVec2; 2]> {
+        let index = self.select_by_depth(centre.as_vec3())?.index;
+        for p in around {
+            if self.select_by_depth(p.as_vec3())?.index != index {
+                return None;
+            }
+        }
+        let cascade = self.cascades.get(index)?;
+        projective_uv_differentials(&cascade.transform.uv_from_world.as_dmat4(), centre, around)
     }
 }
 

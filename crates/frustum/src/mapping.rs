@@ -43,6 +43,67 @@ pub trait ShadowMapping {
     /// The sample for a world point, `None` where the technique does not cover it
     /// (behind a perspective light, beyond the last cascade, ...).
     fn map_point(&self, world: DVec3) -> Option<ShadowSample>;
+
+    /// How texture coordinates change across a pixel: the central differences
+    /// `(uv(around[0]) - uv(around[1])) / 2` and `(uv(around[2]) - uv(around[3])) / 2`
+    /// of four points around `centre` (where a pixel's neighbours meet its surface:
+    /// the Jacobian of an aliasing error), `None` unless the technique covers all
+    /// five points in one layer. The default maps each point with
+    /// [`map_point`](Self::map_point) ([`uv_differentials_by_points`]); a projective
+    /// technique applies its derivative at `centre` to the half-differences of the
+    /// points ([`projective_uv_differentials`]: one division where five mapped
+    /// points take fifteen; equal for an affine map, within the square of the step
+    /// relative to the light-space depth for a perspective one).
+    fn uv_differentials(&self, centre: DVec3, around: &[DVec3; 4]) -> Option<[DVec2; 2]> {
+        uv_differentials_by_points(self, centre, around)
+    }
+}
+
+/// [`ShadowMapping::uv_differentials`] from each point mapped with
+/// [`ShadowMapping::map_point`].
+pub fn uv_differentials_by_points<M: ShadowMapping + ?Sized>(
+    mapping: &M,
+    centre: DVec3,
+    around: &[DVec3; 4],
+) -> Option<[DVec2; 2]> {
+    let layer = mapping.map_point(centre)?.layer;
+    let mut uv = [DVec2::ZERO; 4];
+    for (uv, p) in uv.iter_mut().zip(around) {
+        let s = mapping.map_point(*p)?;
+        if s.layer != layer {
+            return None;
+        }
+        *uv = s.uv;
+    }
+    Some([(uv[0] - uv[1]) * 0.5, (uv[2] - uv[3]) * 0.5])
+}
+
+/// [`ShadowMapping::uv_differentials`] of the projective map `uv_from_world`, for
+/// points its layer holds: `None` where [`ShadowMapping::map_point`] would refuse a
+/// point (behind the projection centre, `w <= 0`, or not finite), else the
+/// derivative at `centre`, `d uv = (d h_xy - uv d h_w) / h_w`, applied to the
+/// half-differences of the two pairs of points.
+pub fn projective_uv_differentials(
+    uv_from_world: &DMat4,
+    centre: DVec3,
+    around: &[DVec3; 4],
+) -> Option<[DVec2; 2]> {
+    let covered = |h: glam::DVec4| h.w > 0.0 && h.is_finite();
+    let h = *uv_from_world * centre.extend(1.0);
+    if !covered(h)
+        || !around
+            .iter()
+            .all(|p| covered(*uv_from_world * p.extend(1.0)))
+    {
+        return None;
+    }
+    let inv_w = 1.0 / h.w;
+    let uv = DVec2::new(h.x, h.y) * inv_w;
+    let column = |a: DVec3, b: DVec3| {
+        let dh = *uv_from_world * ((a - b) * 0.5).extend(0.0);
+        (DVec2::new(dh.x, dh.y) - uv * dh.w) * inv_w
+    };
+    Some([column(around[0], around[1]), column(around[2], around[3])])
 }
 
 /// Which way is "toward the light" for depth bias.
@@ -154,6 +215,10 @@ impl ShadowTransform {
 impl ShadowMapping for ShadowTransform {
     fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
         project_dmat(&self.uv_from_world.as_dmat4(), world)
+    }
+
+    fn uv_differentials(&self, centre: DVec3, around: &[DVec3; 4]) -> Option<[DVec2; 2]> {
+        projective_uv_differentials(&self.uv_from_world.as_dmat4(), centre, around)
     }
 }
 

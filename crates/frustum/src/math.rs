@@ -128,6 +128,23 @@ pub fn acos_clamped(x: f64) -> f64 {
     acos(x.clamp(-1.0, 1.0))
 }
 
+/// `1 / s²`, `s` the [`smaller_singular_value`] of the 2x2 matrix with columns `a`
+/// and `b`, with one square root (the discriminant's) and one division:
+///
+/// ```text
+/// 1 / s_min² = (F + sqrt(F² - 4D²)) / (2D²)
+/// ```
+///
+/// Infinite or NaN where `s` is 0 or undefined (a singular or non-finite matrix).
+#[must_use]
+pub fn inverse_square_smaller_singular_value(a: glam::DVec2, b: glam::DVec2) -> f64 {
+    let frobenius = a.length_squared() + b.length_squared();
+    let det = a.perp_dot(b);
+    let root = sqrt((frobenius * frobenius - 4.0 * det * det).max(0.0));
+    let inv = (frobenius + root) / (2.0 * det * det);
+    if inv > 0.0 { inv } else { f64::INFINITY }
+}
+
 /// The smaller singular value of the 2x2 matrix with columns `a` and `b`: how much
 /// the map stretches the direction it stretches least (the texels per pixel of
 /// Lloyd et al.'s aliasing error, whose inverse is the error).

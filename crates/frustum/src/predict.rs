@@ -263,7 +263,8 @@ pub fn predict_errors(
     Ok(())
 }
 
-/// One candidate's errors, one per ray.
+/// One candidate's errors, one per ray, squared (`m²`: the square root is taken
+/// of the percentile and the maximum only, which it leaves in their places).
 type RayErrors = ArrayVec<f64, MAX_PREDICT_RAYS>;
 
 /// One pass of [`predict_errors`] over the ray grid.
@@ -386,17 +387,23 @@ impl Hit {
     }
 }
 
-/// The percentile and maximum of the errors (sorted in place).
-fn summarize(errors: &mut [f64], percentile: f64) -> Option<PredictedError> {
-    let count = errors.len();
+/// The percentile and maximum of the errors from their squares (reordered in
+/// place: the percentile is selected, not the whole list sorted).
+fn summarize(squares: &mut [f64], percentile: f64) -> Option<PredictedError> {
+    let count = squares.len();
     if count == 0 {
         return None;
     }
-    errors.sort_unstable_by(f64::total_cmp);
+    let max = squares
+        .iter()
+        .copied()
+        .max_by(f64::total_cmp)
+        .unwrap_or(f64::NAN);
     let rank = math::ceil(percentile * count as f64) as usize;
+    let (_, at, _) = squares.select_nth_unstable_by(rank.clamp(1, count) - 1, f64::total_cmp);
     Some(PredictedError {
-        percentile: errors[rank.clamp(1, count) - 1],
-        max: errors[count - 1],
+        percentile: math::sqrt(*at),
+        max: math::sqrt(max),
         rays: count as u32,
     })
 }
@@ -516,26 +523,17 @@ impl Screen {
 /// The points one pixel away on a probe point's plane ([`Screen::pixel_steps`]).
 type PixelSteps = [DVec3; 4];
 
-/// `m` at `point` with the neighbouring pixels' points `steps`, if the mapping covers
-/// the pixel and its neighbours in one layer.
+/// `m²` at `point` with the neighbouring pixels' points `steps`, if the mapping
+/// covers the pixel and its neighbours in one layer.
 fn error_at(
     point: DVec3,
     steps: &PixelSteps,
     mapping: &dyn ShadowMapping,
     texels: f64,
 ) -> Option<f64> {
-    let centre = mapping.map_point(point)?;
-    let mut ends = [DVec2::ZERO; 4];
-    for (end, p) in ends.iter_mut().zip(steps) {
-        let s = mapping.map_point(*p)?;
-        if s.layer != centre.layer {
-            return None;
-        }
-        *end = s.uv * texels;
-    }
-    let columns = [(ends[0] - ends[1]) * 0.5, (ends[2] - ends[3]) * 0.5];
-    let m = 1.0 / math::smaller_singular_value(columns[0], columns[1]);
-    (m.is_finite() && m > 0.0).then_some(m)
+    let [du, dv] = mapping.uv_differentials(point, steps)?;
+    let m2 = math::inverse_square_smaller_singular_value(du * texels, dv * texels);
+    (m2.is_finite() && m2 > 0.0).then_some(m2)
 }
 
 /// Where the segment `origin + s step`, `s` in `[0, 1]`, first meets a face of the box
@@ -581,7 +579,8 @@ fn first_face_hit(origin: DVec3, step: DVec3, b: &Aabb) -> Option<(f64, (f64, f6
 /// Where the line `origin + s dir` meets the plane through `point` with `normal`.
 fn plane_hit(origin: DVec3, dir: DVec3, point: DVec3, normal: DVec3) -> Option<DVec3> {
     let denom = normal.dot(dir);
-    if denom.abs() <= 1e-12 * dir.length() {
+    // `|denom| <= 1e-12 |dir|`, squared: no square root per neighbouring ray.
+    if denom * denom <= 1e-24 * dir.length_squared() {
         return None;
     }
     let s = normal.dot(point - origin) / denom;

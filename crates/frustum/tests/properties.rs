@@ -5,7 +5,7 @@ use glam::{DQuat, DVec3, Mat4, Quat, Vec3};
 use proptest::prelude::*;
 use shadowmap_frustum::{
     Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, ConvexBody, SceneBounds,
-    SplitScheme, ValidCamera,
+    ShadowMapping, SplitScheme, ValidCamera, uv_differentials_by_points,
 };
 use shadowmap_testgen::{
     GenResult, arbitrary::Unstructured, camera, frustum as cases, in_range, light_direction,
@@ -67,6 +67,23 @@ fn f32_tolerance(m: &Mat4, coord: f64) -> [f64; 3] {
     })
 }
 
+/// The cascades of a generated case over the camera's whole depth range.
+fn fitted_set(case: &FitCase) -> CascadeSet {
+    let (near, far) = case.camera.depth_range().unwrap();
+    let splits = CascadeSplits::new(
+        &SplitScheme::Practical {
+            lambda: case.lambda,
+        },
+        case.count,
+        near,
+        far,
+    )
+    .unwrap()
+    .with_overlap(case.overlap)
+    .unwrap();
+    CascadeSet::fit(&case.camera, case.light, &splits, &case.options).unwrap()
+}
+
 proptest! {
     #![proptest_config(shadowmap_testgen::proptest_config())]
 
@@ -74,12 +91,7 @@ proptest! {
     /// `[0, 1]² x [0, 1]`, for tight and stable fits, either depth convention.
     #[test]
     fn slice_points_map_inside_their_cascade(case in strategy(fit_case)) {
-        let (near, far) = case.camera.depth_range().unwrap();
-        let splits = CascadeSplits::new(&SplitScheme::Practical { lambda: case.lambda }, case.count, near, far)
-            .unwrap()
-            .with_overlap(case.overlap)
-            .unwrap();
-        let set = CascadeSet::fit(&case.camera, case.light, &splits, &case.options).unwrap();
+        let set = fitted_set(&case);
         for (i, cascade) in set.cascades.iter().enumerate() {
             let (a, b) = cascade.view_depth;
             let slice = case.camera.slice(a, b).unwrap();
@@ -97,6 +109,54 @@ proptest! {
                 prop_assert!(s.uv.x >= -tu && s.uv.x <= 1.0 + tu, "cascade {i}: u = {} (tol {tu})", s.uv.x);
                 prop_assert!(s.uv.y >= -tv && s.uv.y <= 1.0 + tv, "cascade {i}: v = {} (tol {tv})", s.uv.y);
                 prop_assert!(s.depth >= -tz && s.depth <= 1.0 + tz, "cascade {i}: depth = {} (tol {tz})", s.depth);
+            }
+        }
+    }
+
+    /// The cascades' and a cascade's transform's texture-coordinate differentials
+    /// (the derivative at the centre, one division) are the central differences of
+    /// the points mapped one by one, to the square of the step over the distance,
+    /// and refused where those are (across cascade boundaries, beyond the last
+    /// cascade).
+    #[test]
+    fn uv_differentials_are_the_central_differences(case in strategy(fit_case)) {
+        let set = fitted_set(&case);
+        let (near, far) = case.camera.depth_range().unwrap();
+        let whole = case.camera.slice(near, far).unwrap();
+        let reach = f64::from(whole.corners[4].distance(whole.corners[6]));
+        for w in &case.weights {
+            let sum: f32 = w.iter().sum::<f32>().max(1e-3);
+            let centre = whole.corners.iter().zip(w).fold(Vec3::ZERO, |s, (c, w)| s + *c * (w / sum)).as_dvec3();
+            // Steps from a thousandth of the frustum's far diagonal (within a
+            // cascade) to a tenth (across boundaries).
+            for step in [1e-3, 1e-1].map(|f| reach * f) {
+                let around = [DVec3::X, DVec3::NEG_X, DVec3::Y, DVec3::NEG_Y].map(|d| centre + d * step);
+                let t = &set.cascades[0].transform;
+                for (fast, slow) in [
+                    (set.uv_differentials(centre, &around), uv_differentials_by_points(&set, centre, &around)),
+                    (t.uv_differentials(centre, &around), uv_differentials_by_points(t, centre, &around)),
+                ] {
+                    prop_assert_eq!(fast.is_some(), slow.is_some());
+                    let (Some(fast), Some(slow)) = (fast, slow) else { continue };
+                    // An orthographic map is affine: the derivative is the difference,
+                    // to the rounding of the points' uv, which is that of the terms of
+                    // the matrix product (far larger than uv far from the origin).
+                    let rounding = set
+                        .cascades
+                        .iter()
+                        .map(|c| {
+                            let m = c.transform.uv_from_world.as_dmat4();
+                            let abs = glam::DMat4::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs(), m.w_axis.abs());
+                            let terms = abs * centre.abs().extend(1.0);
+                            terms.x.max(terms.y) / terms.w.max(f64::MIN_POSITIVE)
+                        })
+                        .fold(0.0, f64::max)
+                        * 16.0
+                        * f64::EPSILON;
+                    for (f, s) in fast.iter().zip(&slow) {
+                        prop_assert!((*f - *s).length() <= 1e-9 * s.length() + rounding, "{} vs {}", f, s);
+                    }
+                }
             }
         }
     }

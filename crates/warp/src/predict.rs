@@ -174,7 +174,7 @@ impl Probe {
                 let dh = cx * d.x + cy * d.y + cz * d.z;
                 (DVec2::new(dh.x, dh.y) * hw - DVec2::new(h.x, h.y) * dh.z) / (hw * hw)
             };
-            let inv_s2 = inverse_square_smaller_singular_value(ndc(q.dx), ndc(q.dy));
+            let inv_s2 = math::inverse_square_smaller_singular_value(ndc(q.dx), ndc(q.dy));
             if !(inv_s2 < f64::INFINITY) {
                 return f64::INFINITY;
             }
@@ -365,17 +365,6 @@ fn point_at(ray: &Ray, step: DVec2, s: f64, n: DVec3, weight: f64) -> Option<Poi
 fn pow4(x: f64) -> f64 {
     let x2 = x * x;
     x2 * x2
-}
-
-/// `1 / s²`, `s` the smaller singular value of the 2x2 matrix with columns `a` and
-/// `b` (as [`math::smaller_singular_value`], without its square roots but the
-/// discriminant's): infinite or NaN where `s` is 0 or undefined.
-fn inverse_square_smaller_singular_value(a: DVec2, b: DVec2) -> f64 {
-    let frobenius = a.length_squared() + b.length_squared();
-    let det = a.perp_dot(b);
-    let root = math::sqrt((frobenius * frobenius - 4.0 * det * det).max(0.0));
-    let inv = (frobenius + root) / (2.0 * det * det);
-    if inv > 0.0 { inv } else { f64::INFINITY }
 }
 
 /// Strengths at which a warp is evaluated, as fractions of its formula's warp in

@@ -12,7 +12,7 @@
 //! overlap by the blend band; the nearer, finer cascade wins). A cascade whose slice
 //! missed the receivers (`shadow: None`) maps nothing: those points read as lit.
 
-use glam::{DVec3, Vec3};
+use glam::{DVec2, DVec3, Vec3};
 use shadowmap_frustum::{Camera, ShadowMapping, ShadowSample};
 
 use crate::WarpedCascades;
@@ -76,6 +76,19 @@ impl ShadowMapping for WarpedCascadesView<'_> {
         sample.layer = u32::try_from(index).ok()?;
         Some(sample)
     }
+
+    /// Every point selected by view depth, all in one cascade; that cascade's
+    /// derivative.
+    fn uv_differentials(&self, centre: DVec3, around: &[DVec3; 4]) -> Option<[DVec2; 2]> {
+        let index = self.cascades.select_by_depth(self.view_depth(centre))?;
+        for p in around {
+            if self.cascades.select_by_depth(self.view_depth(*p))? != index {
+                return None;
+            }
+        }
+        let shadow = self.cascades.cascades.get(index)?.shadow.as_ref()?;
+        shadow.transform.uv_differentials(centre, around)
+    }
 }
 
 #[cfg(test)]
@@ -126,6 +139,31 @@ mod tests {
                 .unwrap();
             assert_eq!(s.layer as usize, i);
             assert!((0.0..=1.0).contains(&s.uv.x) && (0.0..=1.0).contains(&s.uv.y));
+        }
+        // The differentials from the derivative are those of each point mapped alone,
+        // within a cascade and across the boundaries (where both refuse).
+        for depth in [1.5, 10.0, 37.0, 90.0, 199.0] {
+            for step in [0.01, 5.0] {
+                let centre = glam::DVec3::new(0.5, 4.0, -depth);
+                let around = [
+                    glam::DVec3::X,
+                    glam::DVec3::NEG_X,
+                    glam::DVec3::Y,
+                    glam::DVec3::NEG_Y,
+                ]
+                .map(|d| centre + d * step);
+                let fast = view.uv_differentials(centre, &around);
+                let slow = shadowmap_frustum::uv_differentials_by_points(&view, centre, &around);
+                assert_eq!(fast.is_some(), slow.is_some(), "at {depth}, step {step}");
+                // Central differences of a perspective map are its derivative to the
+                // square of the step over the distance: compare at the small step.
+                if let (Some(fast), Some(slow), true) = (fast, slow, step < 1.0) {
+                    for (f, s) in fast.iter().zip(&slow) {
+                        let tolerance = 1e-6 * s.length() + 1e-15;
+                        assert!((*f - *s).length() <= tolerance, "{f} vs {s}");
+                    }
+                }
+            }
         }
         // Behind the camera and beyond the last cascade: not mapped.
         assert!(view.map_point(glam::DVec3::new(0.0, 0.0, 5.0)).is_none());

@@ -166,6 +166,20 @@ fn nothing_met_or_bad_input_is_reported() {
     }
 }
 
+/// A wrapped map's differentials where a wrapper covers all five points (as it
+/// maps them one by one: the wrapped map's own, where it covers them).
+fn differentials_where(
+    map: &ShadowTransform,
+    centre: glam::DVec3,
+    around: &[glam::DVec3; 4],
+    covers: impl Fn(&glam::DVec3) -> bool,
+) -> Option<[glam::DVec2; 2]> {
+    let covered = core::iter::once(&centre).chain(around).all(covers);
+    covered
+        .then(|| map.uv_differentials(centre, around))
+        .flatten()
+}
+
 /// A mapping that covers only points nearer than `depth` in front of the camera.
 struct NearOnly(ShadowTransform, f64);
 
@@ -174,6 +188,14 @@ impl ShadowMapping for NearOnly {
         (-world.z < self.1)
             .then(|| self.0.map_point(world))
             .flatten()
+    }
+
+    fn uv_differentials(
+        &self,
+        centre: glam::DVec3,
+        around: &[glam::DVec3; 4],
+    ) -> Option<[glam::DVec2; 2]> {
+        differentials_where(&self.0, centre, around, |p| -p.z < self.1)
     }
 }
 
@@ -215,6 +237,16 @@ impl ShadowMapping for DepthOnly {
         (-world.z >= self.1 && -world.z <= self.2)
             .then(|| self.0.map_point(world))
             .flatten()
+    }
+
+    fn uv_differentials(
+        &self,
+        centre: glam::DVec3,
+        around: &[glam::DVec3; 4],
+    ) -> Option<[glam::DVec2; 2]> {
+        differentials_where(&self.0, centre, around, |p| {
+            -p.z >= self.1 && -p.z <= self.2
+        })
     }
 }
 
