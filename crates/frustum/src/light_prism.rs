@@ -201,7 +201,9 @@ mod tests {
                 for j in 0..=n {
                     for k in 0..=n {
                         let t = DVec3::new(f64::from(i), f64::from(j), f64::from(k)) / f64::from(n);
-                        let p = b.min.as_dvec3() + (b.max - b.min).as_dvec3() * t;
+                        // The box's extent in f64: its f32 difference rounds the far
+                        // corner off the box by a few ulps.
+                        let p = b.min.as_dvec3() + (b.max.as_dvec3() - b.min.as_dvec3()) * t;
                         let q = light(p);
                         if q.x >= min.x && q.x <= max.x && q.y >= min.y && q.y <= max.y {
                             let (z_lo, z_hi) = range.expect("the box meets the prism");
