@@ -1,7 +1,8 @@
 //! Per-frame cost of the umbrella's stateful fits of a directional light
 //! (`shadowmap::fit_with_state`): the stable, tight and warped cascades with their
-//! count chosen from the predicted error, and `auto`, which fits and predicts all
-//! seven candidates; each beside the uniform fit timed in the same run. Besides
+//! count chosen from the predicted error, and `auto`, which fits all seven
+//! candidates and predicts their error (or, given the eye samples of a 160 x 90
+//! G-buffer, measures it on them); each beside the uniform fit timed in the same run. Besides
 //! criterion's figures it prints each fit's time per call (the fastest of many short
 //! batches, see `support/timing.rs`) and its ratio to the uniform fit. `FIT_STATE_ONLY`
 //! runs one fit for instruction counting (see `only`).
@@ -9,6 +10,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use shadowmap::frustum::{Aabb, Camera, DepthBounds, Light, Projection, SceneBounds};
+use shadowmap::rtw::EyeSample;
 use shadowmap::{CascadePlan, FitInput, FitState, Technique, fit_with_state};
 use std::hint::black_box;
 
@@ -45,7 +47,7 @@ fn frame() -> (Camera, Light, SceneBounds, DepthBounds) {
 /// two values of `n`, the difference of the instruction counts divided by the
 /// difference of `n` is the fit's instructions per frame, repeatable on a loaded
 /// machine.
-fn only(techniques: &[(&str, Technique)], input: &FitInput<'_>) -> bool {
+fn only(techniques: &[(&str, Technique, &FitInput<'_>)]) -> bool {
     let Ok(name) = std::env::var("FIT_STATE_ONLY") else {
         return false;
     };
@@ -53,9 +55,9 @@ fn only(techniques: &[(&str, Technique)], input: &FitInput<'_>) -> bool {
         .ok()
         .and_then(|n| n.parse().ok())
         .unwrap_or(1);
-    let (_, technique) = techniques
+    let (_, technique, input) = techniques
         .iter()
-        .find(|(n, _)| *n == name)
+        .find(|(n, _, _)| *n == name)
         .unwrap_or_else(|| panic!("FIT_STATE_ONLY: no fit {name}"));
     let mut state = FitState::default();
     for _ in 0..calls {
@@ -64,43 +66,76 @@ fn only(techniques: &[(&str, Technique)], input: &FitInput<'_>) -> bool {
     true
 }
 
+/// What a 160 x 90 G-buffer of the street view holds: where the camera's pixel
+/// rays meet the ground (`y = 0`).
+fn ground_samples(camera: &Camera) -> Vec<EyeSample> {
+    let c = camera.frustum().unwrap().corners;
+    let eye = camera.eye();
+    let (columns, rows) = (160, 90);
+    let mut out = Vec::new();
+    for row in 0..rows {
+        for column in 0..columns {
+            let x = (column as f32 + 0.5) / columns as f32;
+            let y = (row as f32 + 0.5) / rows as f32;
+            let d = (c[0].lerp(c[1], x).lerp(c[3].lerp(c[2], x), y) - eye).normalize();
+            if d.y < -1e-3 {
+                let t = -eye.y / d.y;
+                out.push(EyeSample {
+                    position: eye + d * t,
+                    normal: Vec3::Y,
+                    eye_distance: t,
+                });
+            }
+        }
+    }
+    out
+}
+
 #[allow(clippy::print_stdout)] // The table is this bench's output.
 fn fits(c: &mut Criterion) {
     let (camera, light, scene, bounds) = frame();
     let input = FitInput::new(&camera, &light, scene, 2048 * 2048).with_depth_bounds(Some(bounds));
+    let samples = ground_samples(&camera);
+    // 90 pixel rows over the vertical field of view of 1 rad.
+    let sampled = input
+        .with_eye_samples(&samples)
+        .with_pixels_per_radian(90.0 / 1.0);
     let plan = CascadePlan::default();
+    let warped = Technique::WarpedCascades {
+        plan,
+        lispsm: Default::default(),
+    };
     let techniques = [
-        ("uniform", Technique::UniformFocused(Default::default())),
-        ("tight_cascades", Technique::TightCascades(plan)),
-        ("stable_cascades", Technique::StableCascades(plan)),
         (
-            "warped_cascades",
-            Technique::WarpedCascades {
-                plan,
-                lispsm: Default::default(),
-            },
+            "uniform",
+            Technique::UniformFocused(Default::default()),
+            &input,
         ),
-        ("auto", Technique::Auto(plan)),
+        ("tight_cascades", Technique::TightCascades(plan), &input),
+        ("stable_cascades", Technique::StableCascades(plan), &input),
+        ("warped_cascades", warped, &input),
+        ("auto", Technique::Auto(plan), &input),
+        ("auto_on_samples", Technique::Auto(plan), &sampled),
     ];
-    if only(&techniques, &input) {
+    if only(&techniques) {
         return;
     }
     let mut group = c.benchmark_group("fit_with_state");
-    for (name, technique) in &techniques {
+    for (name, technique, input) in &techniques {
         let mut state = FitState::default();
         group.bench_function(*name, |b| {
-            b.iter(|| fit_with_state(black_box(technique), black_box(&input), &mut state));
+            b.iter(|| fit_with_state(black_box(technique), black_box(input), &mut state));
         });
     }
     group.finish();
-    let time = |technique: &Technique| {
+    let time = |technique: &Technique, input: &FitInput<'_>| {
         let mut state = FitState::default();
-        timing::min_ns(|| fit_with_state(technique, &input, &mut state))
+        timing::min_ns(|| fit_with_state(technique, input, &mut state))
     };
-    let uniform = time(&techniques[0].1);
+    let uniform = time(&techniques[0].1, &input);
     println!("\nper-frame fit_with_state, fastest batch (same run):");
-    for (name, technique) in &techniques {
-        let ns = time(technique);
+    for (name, technique, input) in &techniques {
+        let ns = time(technique, input);
         println!(
             "  {name:<16} {:>9.1} us  {:>6.1}x uniform",
             ns / 1e3,

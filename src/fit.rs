@@ -23,7 +23,9 @@ use crate::technique::{DpsmOptions, RtwPlan, Technique};
 ///
 /// Required: camera, light, scene bounds, texel budget. Optional, read only by the
 /// techniques that need them (see the crate docs' table):
-/// [`eye_samples`](Self::eye_samples) (RTW and the RTW oracle, required there),
+/// [`eye_samples`](Self::eye_samples) (RTW and the RTW oracle, required there;
+/// `auto` and IPSM measure their candidates on them with
+/// [`pixels_per_radian`](Self::pixels_per_radian)),
 /// [`pixels_per_radian`](Self::pixels_per_radian) (RTW oracle, required there),
 /// [`depth_bounds`](Self::depth_bounds) (cascades, warped cascades, auto, IPSM, cube maps; the
 /// camera's depth range without them).

@@ -13,7 +13,7 @@ use shadowmap_rtw::{
 };
 
 use crate::fit::{FitError, FitInput, layer_side};
-use crate::sample_error::{MAX_SAMPLES, percentile_of, sample_error};
+use crate::sample_error::{MAX_SAMPLES, Samples, percentile_of, sample_error};
 use crate::shadow::Fitted;
 use crate::technique::RtwPlan;
 
@@ -87,10 +87,8 @@ pub(crate) fn fit_ipsm(options: &IpsmOptions, input: &FitInput<'_>) -> Result<Ip
         let side = f64::from(layer_side(input.texel_budget, p.map.layers()));
         sample_error(
             &p.map,
-            &|_| side,
-            input.camera,
-            ppr,
-            samples,
+            side,
+            &Samples::new(input.camera, ppr, samples),
             LightDirection::Position(p.map.position),
             NEED_PERCENTILE,
         )

@@ -5,7 +5,7 @@ use shadowmap_frustum::{Camera, LightDirection, ShadowTransform};
 use shadowmap_rtw::{EyeSample, ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
 
 use crate::fit::FitError;
-use crate::sample_error::sample_error;
+use crate::sample_error::{Samples, sample_error};
 
 /// Strengths tried, as exponents of the importance (0: the uniform fit, 1: the
 /// importance as accumulated).
@@ -44,10 +44,8 @@ pub(crate) fn build_measured(
     let measure = |mapping: &RtwShadow<'_>| {
         sample_error(
             mapping,
-            &|_| 1.0,
-            camera,
-            PIXELS_PER_RADIAN,
-            samples,
+            1.0,
+            &Samples::new(camera, PIXELS_PER_RADIAN, samples),
             light,
             0.95,
         )
@@ -115,8 +113,8 @@ mod tests {
     /// The measure `build_measured` ranks strengths by.
     fn measured(camera: &Camera, light: Vec3, samples: &[EyeSample], m: &RtwShadow<'_>) -> f64 {
         let light = LightDirection::Directional(light);
-        sample_error(m, &|_| 1.0, camera, PIXELS_PER_RADIAN, samples, light, 0.95)
-            .unwrap_or(f64::INFINITY)
+        let samples = Samples::new(camera, PIXELS_PER_RADIAN, samples);
+        sample_error(m, 1.0, &samples, light, 0.95).unwrap_or(f64::INFINITY)
     }
 
     #[test]

@@ -4,7 +4,6 @@
 //! samples instead of rendered pixels.
 
 use arrayvec::ArrayVec;
-use glam::{DVec2, DVec3};
 use shadowmap_frustum::{Camera, FRONT_LIT_MIN_COS, LightDirection, ShadowMapping, math};
 use shadowmap_rtw::{EyeSample, PixelSteps};
 
@@ -12,33 +11,75 @@ use shadowmap_rtw::{EyeSample, PixelSteps};
 /// measure needs no heap).
 pub(crate) const MAX_SAMPLES: usize = 4096;
 
-/// The `percentile` (in `(0, 1]`) of `m` over the samples `mapping` covers, its
-/// layer `l` having `side(l)` texels per side; `None` when it covers none. A sample's
+/// The surface a sample's error is measured on where the light does not reach it
+/// from the front (`n . l` below `FRONT_LIT_MIN_COS`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Unlit {
+    /// Left out, as the quality report measures `m` (`auto`'s ranking).
+    Skipped,
+    /// The plane facing the bisector of the eye and light directions (a map's need
+    /// there still matters to the fits that size or warp it).
+    Bisector,
+}
+
+/// What [`sample_error`] measures: the samples, how many at most, and their image.
+#[derive(Clone, Copy)]
+pub(crate) struct Samples<'a> {
+    pub(crate) camera: &'a Camera,
+    pub(crate) pixels_per_radian: f32,
+    pub(crate) samples: &'a [EyeSample],
+    /// A regular subset of at most this many (at most [`MAX_SAMPLES`]).
+    pub(crate) most: usize,
+    pub(crate) unlit: Unlit,
+}
+
+impl<'a> Samples<'a> {
+    /// Every sample (up to [`MAX_SAMPLES`]), the unlit ones on the bisector's plane.
+    pub(crate) fn new(
+        camera: &'a Camera,
+        pixels_per_radian: f32,
+        samples: &'a [EyeSample],
+    ) -> Self {
+        Self {
+            camera,
+            pixels_per_radian,
+            samples,
+            most: MAX_SAMPLES,
+            unlit: Unlit::Bisector,
+        }
+    }
+}
+
+/// The `percentile` (in `(0, 1]`) of `m` over the samples `mapping` covers, each of
+/// its layers having `texels` texels per side; `None` when it covers none. A sample's
 /// surface is its own where the light reaches it from the front (`n . l` at least
-/// `FRONT_LIT_MIN_COS`, as the report measures `m`), the plane facing the bisector
-/// of the eye and light directions elsewhere; a sample whose one-pixel neighbours
-/// fall outside the map or into another layer is left out. The pixel steps are
-/// `shadowmap_rtw::PixelSteps`, the footprint the RTW oracle uses.
+/// `FRONT_LIT_MIN_COS`, as the report measures `m`); elsewhere as `samples.unlit`
+/// says. A sample whose one-pixel neighbours fall outside the map or into another
+/// layer is left out. The pixel steps are `shadowmap_rtw::PixelSteps`, the footprint
+/// the RTW oracle uses; the texture coordinates' differences are the mapping's
+/// [`uv_differentials`](ShadowMapping::uv_differentials) (the derivative of a matrix
+/// technique's matrix).
 pub(crate) fn sample_error(
     mapping: &dyn ShadowMapping,
-    side: &dyn Fn(u32) -> f64,
-    camera: &Camera,
-    pixels_per_radian: f32,
-    samples: &[EyeSample],
+    texels: f64,
+    samples: &Samples<'_>,
     light: LightDirection,
     percentile: f64,
 ) -> Option<f64> {
     let probe = Probe {
-        steps: PixelSteps::new(camera),
-        pixels_per_radian: f64::from(pixels_per_radian),
+        steps: PixelSteps::new(samples.camera),
+        pixels_per_radian: f64::from(samples.pixels_per_radian),
         light,
+        unlit: samples.unlit,
     };
-    let stride = samples.len().div_ceil(MAX_SAMPLES).max(1);
+    let most = samples.most.clamp(1, MAX_SAMPLES);
+    let stride = samples.samples.len().div_ceil(most).max(1);
     let mut errors: ArrayVec<f64, MAX_SAMPLES> = samples
+        .samples
         .iter()
         .step_by(stride)
-        .filter_map(|s| probe.error(mapping, side, s))
-        .take(MAX_SAMPLES)
+        .filter_map(|s| probe.error(mapping, texels, s))
+        .take(most)
         .collect();
     percentile_of(&mut errors, percentile)
 }
@@ -48,34 +89,27 @@ struct Probe {
     steps: PixelSteps,
     pixels_per_radian: f64,
     light: LightDirection,
+    unlit: Unlit,
 }
 
 impl Probe {
-    fn error(
-        &self,
-        mapping: &dyn ShadowMapping,
-        side: &dyn Fn(u32) -> f64,
-        s: &EyeSample,
-    ) -> Option<f64> {
+    fn error(&self, mapping: &dyn ShadowMapping, texels: f64, s: &EyeSample) -> Option<f64> {
         let p = s.position.as_dvec3();
         let to_eye = -self.steps.ray(p)?;
         let to_light = self.light.toward(p);
         let n = s.normal.as_dvec3().normalize_or_zero();
         let n = if n.dot(to_light) >= FRONT_LIT_MIN_COS {
             n
+        } else if self.unlit == Unlit::Skipped {
+            return None;
         } else {
             (to_eye + to_light).normalize_or_zero()
         };
-        // Half-pixel steps each way: the central difference of one pixel.
+        // Half-pixel steps each way: the difference across one pixel, twice the
+        // mapping's half-differences (an exact doubling).
         let (dx, dy) = self.steps.at(p, n, 2.0 * self.pixels_per_radian)?;
-        let centre = mapping.map_point(p)?;
-        let texels = side(centre.layer);
-        let column = |d: DVec3| -> Option<DVec2> {
-            let (a, b) = (mapping.map_point(p + d)?, mapping.map_point(p - d)?);
-            (a.layer == centre.layer && b.layer == centre.layer).then(|| (a.uv - b.uv) * texels)
-        };
-        let (jx, jy) = (column(dx)?, column(dy)?);
-        let m = 1.0 / math::smaller_singular_value(jx, jy);
+        let [jx, jy] = mapping.uv_differentials(p, &[p + dx, p - dx, p + dy, p - dy])?;
+        let m = 1.0 / math::smaller_singular_value(jx * 2.0 * texels, jy * 2.0 * texels);
         (m.is_finite() && m > 0.0).then_some(m)
     }
 }
@@ -113,7 +147,7 @@ mod tests {
         let lit = [sample(Vec3::new(0.0, 0.0, -10.0), Vec3::Y)];
         let error = |samples: &[EyeSample], side: f64| {
             let l = LightDirection::Directional(light);
-            sample_error(&map, &|_| side, &camera, 1e3, samples, l, 0.95)
+            sample_error(&map, side, &Samples::new(&camera, 1e3, samples), l, 0.95)
         };
         let m = error(&lit, 1024.0).unwrap();
         assert!((error(&lit, 2048.0).unwrap() - 0.5 * m).abs() < 1e-9 * m);

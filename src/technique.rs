@@ -51,13 +51,16 @@ pub enum Technique {
     },
     /// The candidate of [`auto_candidates`](crate::auto_candidates) (uniform,
     /// LiSPSM, TSM, XPSM and the three cascaded techniques with this plan) with the
-    /// lowest 95th-percentile error predicted from the camera, light and bounds alone
+    /// lowest 95th-percentile aliasing error: measured on the eye samples when the
+    /// frame has them and the image's focal length (the quality report's measure on
+    /// at most [`AUTO_MAX_SAMPLES`](crate::AUTO_MAX_SAMPLES) front-lit samples),
+    /// otherwise predicted from the camera, light and bounds alone
     /// (`shadowmap_frustum::predict_errors`: the receivers' box within the depth
     /// bounds, no rendering), with hysteresis across frames through a caller-held
-    /// selector ([`fit_with_selector`](crate::fit_with_selector)): candidates that
-    /// predict within the selector's margin of the current one do not take over, so
-    /// the choice does not flip every frame. The uniform fit is a candidate, so
-    /// `auto` is never predicted worse than it. Directional light.
+    /// selector ([`fit_with_selector`](crate::fit_with_selector)): candidates within
+    /// the selector's margin of the current one do not take over, so the choice does
+    /// not flip every frame. The uniform fit is a candidate, so `auto` is never
+    /// measured (or predicted) worse than it. Directional light.
     Auto(CascadePlan),
     /// Rectilinear texture warping (Rosen) over the uniform fit, importance from the
     /// eye's samples (backward analysis) that the light reaches: a sample on a
