@@ -10,7 +10,7 @@
 //!
 //! | light | techniques |
 //! |---|---|
-//! | directional | uniform focused, stable and tight cascades (PSSM over the depth bounds), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), auto (the candidate with the lowest predicted error), RTW (backward importance), RTW oracle |
+//! | directional | uniform focused, stable and tight cascades (PSSM over the depth bounds), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), auto (the candidate with the lowest error on the eye samples), RTW (backward importance), RTW oracle |
 //! | spot | spot fit, LiSPSM and TSM in the spot's post-projective space, RTW over the spot fit |
 //! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone (both measured on the eye's samples against their dual alternatives), cube maps focused on the visible receivers with faces sized by the samples' needs, the engines' cube maps (equal full faces: a reference, not one of the library's techniques), RTW over the IPSM paraboloid, RTW over the focused cube faces |
 //!
