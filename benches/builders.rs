@@ -268,17 +268,12 @@ fn run(f: &Frame, out: &mut Outputs, which: usize) {
 }
 
 /// With `BUILDERS_ONLY=<name>` (and `BUILDERS_CALLS=<n>`, default 1), calls that one
-/// builder `n` times and times nothing: run under `valgrind --tool=callgrind` with two
-/// values of `n`, the difference of the instruction counts divided by the difference
-/// of `n` is the builder's instructions per call, repeatable on a loaded machine.
+/// builder `n` times and times nothing, for instruction counts
+/// (`timing::only_request`).
 fn only(f: &Frame, out: &mut Outputs) -> bool {
-    let Ok(name) = std::env::var("BUILDERS_ONLY") else {
+    let Some((name, calls)) = timing::only_request("BUILDERS_ONLY", "BUILDERS_CALLS") else {
         return false;
     };
-    let calls: usize = std::env::var("BUILDERS_CALLS")
-        .ok()
-        .and_then(|n| n.parse().ok())
-        .unwrap_or(1);
     let which = NAMES
         .iter()
         .position(|n| *n == name)

@@ -43,18 +43,12 @@ fn frame() -> (Camera, Light, SceneBounds, DepthBounds) {
 }
 
 /// With `FIT_STATE_ONLY=<name>` (and `FIT_STATE_CALLS=<n>`, default 1), fits that
-/// technique `n` times and times nothing: run under `valgrind --tool=callgrind` with
-/// two values of `n`, the difference of the instruction counts divided by the
-/// difference of `n` is the fit's instructions per frame, repeatable on a loaded
-/// machine.
+/// technique `n` times and times nothing, for instruction counts
+/// (`timing::only_request`).
 fn only(techniques: &[(&str, Technique, &FitInput<'_>)]) -> bool {
-    let Ok(name) = std::env::var("FIT_STATE_ONLY") else {
+    let Some((name, calls)) = timing::only_request("FIT_STATE_ONLY", "FIT_STATE_CALLS") else {
         return false;
     };
-    let calls: usize = std::env::var("FIT_STATE_CALLS")
-        .ok()
-        .and_then(|n| n.parse().ok())
-        .unwrap_or(1);
     let (_, technique, input) = techniques
         .iter()
         .find(|(n, _, _)| *n == name)

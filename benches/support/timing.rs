@@ -32,3 +32,18 @@ pub(crate) fn min_ns<R>(mut f: impl FnMut() -> R) -> f64 {
         })
         .fold(f64::INFINITY, f64::min)
 }
+
+/// The instruction-counting request of a bench: the name in `name_var` and the call
+/// count in `calls_var` (default 1), `None` when `name_var` is not set. Running one
+/// thing `n` times under `valgrind --tool=callgrind` with two values of `n`, the
+/// difference of the instruction counts over the difference of `n` is its
+/// instructions per call, repeatable on a loaded machine.
+#[allow(dead_code)] // Only the benches that count instructions ask for it.
+pub(crate) fn only_request(name_var: &str, calls_var: &str) -> Option<(String, usize)> {
+    let name = std::env::var(name_var).ok()?;
+    let calls = std::env::var(calls_var)
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(1);
+    Some((name, calls))
+}

@@ -85,6 +85,7 @@ mod body;
 mod bounding_sphere;
 mod camera;
 mod cascade;
+mod cascade_fit;
 mod cascade_state;
 mod clip;
 mod depth_bounds;
@@ -111,7 +112,8 @@ mod serde_impls;
 
 pub use body::{ConvexBody, MAX_BODY_VERTICES};
 pub use camera::{Camera, Projection};
-pub use cascade::{Cascade, CascadeFit, CascadeOptions, CascadeSet, fit_cascade};
+pub use cascade::{Cascade, CascadeFit, CascadeOptions, CascadeSet};
+pub use cascade_fit::fit_cascade;
 pub use cascade_state::{CascadeState, STABLE_HEADROOM, STABLE_SHRINK_RATIO, STABLE_TURN};
 pub use clip::MAX_FRUSTUM_AABB_VERTICES;
 pub use depth_bounds::DepthBounds;
