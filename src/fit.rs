@@ -354,6 +354,11 @@ fn fit_one(
             let layers = fitted.layer_count();
             (fitted, layers)
         }
+        Technique::TiledCube { cube, tiles } => {
+            let fitted = point_fit::fit_tiled_cube(cube, tiles, input)?;
+            let layers = fitted.layer_count();
+            (fitted, layers)
+        }
     })
 }
 

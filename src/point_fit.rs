@@ -1,5 +1,5 @@
-//! The fits of RTW over the point-light bases: each side of the IPSM paraboloid, and
-//! each focused face of the cube map.
+//! The fits of RTW over the point-light bases (each side of the IPSM paraboloid, each
+//! focused face of the cube map) and of the tiled cube map.
 
 use alloc::vec::Vec;
 
@@ -7,7 +7,9 @@ use arrayvec::ArrayVec;
 use glam::DVec3;
 use shadowmap_frustum::math::sqrt;
 use shadowmap_frustum::{LightDirection, ShadowMapping};
-use shadowmap_paraboloid::{CubeMap, CubeOptions, FaceSizes, IpsmOptions, IpsmPlan, Side};
+use shadowmap_paraboloid::{
+    CubeMap, CubeOptions, FaceSizes, IpsmOptions, IpsmPlan, Side, TileOptions, TiledCube,
+};
 use shadowmap_rtw::{
     AxisNeed, BasePoint, EyeSample, ImportanceMap, WarpMaps, oracle_needs, oracle_needs_where,
 };
@@ -224,6 +226,24 @@ fn percentile(values: &mut [f64]) -> Option<f64> {
     percentile_of(values, NEED_PERCENTILE)
 }
 
+/// The focused faces of equal sizes, each narrowed to the eye samples it stores
+/// ([`narrow_to_samples`]), with the samples and the image's focal length that
+/// `technique` requires.
+fn narrowed_faces<'a>(
+    options: &CubeOptions,
+    input: &FitInput<'a>,
+    technique: &'static str,
+) -> Result<(CubeMap, &'a [EyeSample], f32), FitError> {
+    let samples = eye_samples(input, technique)?;
+    let pixels_per_radian = input.pixels_per_radian.ok_or(FitError::MissingInput {
+        technique,
+        input: "pixels_per_radian",
+    })?;
+    let mut cube = fit_faces(&options.with_sizes(FaceSizes::Equal), input)?;
+    narrow_to_samples(&mut cube, samples)?;
+    Ok((cube, samples, pixels_per_radian))
+}
+
 /// RTW over the focused faces of a cube map: per kept face, each eye sample the face
 /// stores asks for the texel density it needs along the face's `u` and `v` (the
 /// oracle's exact requirement, [`oracle_needs`]: the screen-to-texture Jacobian
@@ -239,13 +259,7 @@ pub(crate) fn fit_cube_rtw(
     plan: &RtwPlan,
     input: &FitInput<'_>,
 ) -> Result<Fitted, FitError> {
-    let samples = eye_samples(input, "cube_rtw")?;
-    let pixels_per_radian = input.pixels_per_radian.ok_or(FitError::MissingInput {
-        technique: "cube_rtw",
-        input: "pixels_per_radian",
-    })?;
-    let mut cube = fit_faces(&options.with_sizes(FaceSizes::Equal), input)?;
-    narrow_to_samples(&mut cube, samples)?;
+    let (mut cube, samples, pixels_per_radian) = narrowed_faces(options, input, "cube_rtw")?;
     let n = plan.importance_side;
     let (mut map_u, mut map_v) = (ImportanceMap::new(n, n)?, ImportanceMap::new(n, n)?);
     let mut warps = Vec::with_capacity(cube.faces.len());
@@ -273,6 +287,53 @@ pub(crate) fn fit_cube_rtw(
     Ok(Fitted::CubeRtw { cube, warps })
 }
 
+/// Tiled cube maps: the focused faces narrowed to the samples they store (as for
+/// [`fit_cube_rtw`]), each cut into `tiles.grid²` cells, each cell's tile as many
+/// texels per unit of face `uv` as the [`NEED_PERCENTILE`] of its samples' isotropic
+/// need ([`oracle_needs`]: the largest extent of one unit of `uv` on the screen, in
+/// pixels, with the true normal where the sample is lit from the front and the
+/// bisector elsewhere), all tiles scaled together to the budget.
+pub(crate) fn fit_tiled_cube(
+    options: &CubeOptions,
+    tiles: &TileOptions,
+    input: &FitInput<'_>,
+) -> Result<Fitted, FitError> {
+    tiles.validate()?;
+    let (cube, samples, pixels_per_radian) = narrowed_faces(options, input, "cube_tiled")?;
+    let grid = tiles.grid as usize;
+    let by_face = samples_by_face(&cube, samples);
+    // (cell, need) of every sample, then each cell's percentile.
+    let mut needs: Vec<(usize, f64)> = Vec::with_capacity(samples.len());
+    let mut face_needs: Vec<AxisNeed> = Vec::new();
+    for (layer, stored) in (0..cube.layers()).zip(&by_face) {
+        stored_needs(
+            &cube,
+            layer,
+            input.camera,
+            pixels_per_radian,
+            stored,
+            &mut face_needs,
+            |n| n.isotropic.is_finite() && n.isotropic > 0.0,
+        )?;
+        let cell = |x: f64| ((x * grid as f64).max(0.0) as usize).min(grid - 1);
+        let first = layer as usize * grid * grid;
+        needs.extend(
+            face_needs
+                .iter()
+                .map(|n| (first + cell(n.uv.y) * grid + cell(n.uv.x), n.isotropic)),
+        );
+    }
+    let mut densities = alloc::vec![0.0; cube.faces.len() * grid * grid];
+    needs.sort_unstable_by_key(|n| n.0);
+    for run in needs.chunk_by_mut(|a, b| a.0 == b.0) {
+        let cell = run[0].0;
+        let mut values: Vec<f64> = run.iter().map(|n| n.1).collect();
+        densities[cell] = percentile(&mut values).unwrap_or(0.0);
+    }
+    let tiled = TiledCube::new(cube, tiles, &densities, input.texel_budget)?;
+    Ok(Fitted::TiledCube(tiled))
+}
+
 /// Share of a face's samples whose need decides its size.
 const NEED_PERCENTILE: f64 = 0.95;
 
@@ -298,8 +359,8 @@ mod tests {
     use proptest::prelude::*;
     use shadowmap_frustum::SceneBounds;
     use shadowmap_testgen::point_rtw::{
-        CubeSamplesCase, PointRtwCase, check_cube_samples, check_point_rtw, cube_samples_case,
-        point_rtw_case,
+        CubeSamplesCase, PointRtwCase, check_cube_samples, check_point_rtw, check_tiled_samples,
+        cube_samples_case, point_rtw_case,
     };
     use shadowmap_testgen::strategy;
 
@@ -358,8 +419,30 @@ mod tests {
         check_cube_samples(case, cube, &shadow, budget)
     }
 
+    /// Fits tiled cube maps to a case and checks that the tiles store every sample
+    /// the cube's windows store, inside an atlas of the budget; the number checked.
+    fn fit_tiled_and_check(case: &CubeSamplesCase) -> Result<usize, String> {
+        let c = &case.cube;
+        let budget = 1 << 16;
+        let input = FitInput::new(&c.camera, &c.light, c.scene, budget)
+            .with_eye_samples(&case.samples)
+            .with_depth_bounds(c.bounds)
+            .with_pixels_per_radian(case.pixels_per_radian);
+        let technique = Technique::TiledCube {
+            cube: c.options,
+            tiles: TileOptions::default(),
+        };
+        let Ok(shadow) = fit(&technique, &input) else {
+            return Ok(0);
+        };
+        let tiled = shadow.tiled_cube().ok_or("not a tiled cube map")?;
+        assert_eq!(shadow.texels(), tiled.texels());
+        assert_eq!(shadow.layers(), tiled.layers());
+        check_tiled_samples(case, tiled, &shadow, budget)
+    }
+
     /// The property below checks samples on most generated cases, with and without
-    /// the warp (not a generator whose fits all fail).
+    /// the warp, and tiled (not a generator whose fits all fail).
     #[test]
     fn cube_cases_reach_fitted_maps() {
         use shadowmap_testgen::arbitrary::Unstructured;
@@ -375,9 +458,12 @@ mod tests {
                 fitted += usize::from(n > 0);
                 checked += n;
             }
+            let n = fit_tiled_and_check(&case).unwrap();
+            fitted += usize::from(n > 0);
+            checked += n;
         }
         assert!(
-            fitted > 300 && checked > 10_000,
+            fitted > 450 && checked > 15_000,
             "{fitted} fits, {checked} samples"
         );
     }
@@ -391,6 +477,14 @@ mod tests {
         #[test]
         fn cube_faces_cover_their_samples(case in strategy(cube_samples_case), warped: bool) {
             fit_cube_and_check(&case, warped).map_err(TestCaseError::fail)?;
+        }
+
+        /// Tiled cube maps store every sample their cube's windows store, each in
+        /// the tile of its face and cell, inside the tile's square of an atlas within
+        /// the budget, the tiles apart.
+        #[test]
+        fn tiled_cube_covers_its_samples(case in strategy(cube_samples_case)) {
+            fit_tiled_and_check(&case).map_err(TestCaseError::fail)?;
         }
 
         /// Every sample the IPSM paraboloid stores is stored by RTW over it, in the

@@ -7,7 +7,7 @@ use shadowmap_frustum::{
     CascadeSet, ShadowMapping, ShadowSample, ShadowTransform, SpotShadow,
     uv_differentials_by_points,
 };
-use shadowmap_paraboloid::{CubeMap, IpsmPlan, ParaboloidMap};
+use shadowmap_paraboloid::{CubeMap, IpsmPlan, ParaboloidMap, TiledCube};
 use shadowmap_rtw::{RtwShadow, WarpMaps};
 use shadowmap_warp::{
     LispsmShadow, SpotWarpShadow, TsmShadow, WarpedCascades, WarpedCascadesView, XpsmShadow,
@@ -72,6 +72,8 @@ pub enum Fitted {
         /// Each face's tables.
         warps: Vec<WarpMaps>,
     },
+    /// Tiled cube maps: the focused faces' tiles in one atlas.
+    TiledCube(TiledCube),
     /// RTW over the IPSM paraboloid: the plan and one pair of warp tables per side.
     PointRtw {
         /// The paraboloid plan whose sides are warped.
@@ -127,7 +129,8 @@ impl Shadow {
     }
 
     /// Side in texels of each (square) layer; for cube maps, the largest face's
-    /// (their faces may differ: see [`CubeMap::faces`]).
+    /// (their faces may differ: see [`CubeMap::faces`]); for tiled cube maps, the
+    /// atlas's larger side (the texture that holds every tile).
     #[must_use]
     pub const fn layer_side(&self) -> u32 {
         self.layer_side
@@ -136,6 +139,9 @@ impl Shadow {
     /// Texels over all layers (at most the budget): for cube maps, their atlas.
     #[must_use]
     pub fn texels(&self) -> u64 {
+        if let Fitted::TiledCube(tiled) = &self.fitted {
+            return tiled.texels();
+        }
         match self.cube() {
             Some(cube) => cube.texels(),
             _ => u64::from(self.layer_side) * u64::from(self.layer_side) * u64::from(self.layers),
@@ -177,6 +183,15 @@ impl Shadow {
         }
     }
 
+    /// The tiles of [`Technique::TiledCube`].
+    #[must_use]
+    pub const fn tiled_cube(&self) -> Option<&TiledCube> {
+        match &self.fitted {
+            Fitted::TiledCube(tiled) => Some(tiled),
+            _ => None,
+        }
+    }
+
     /// RTW's base fit and tables, borrowed as the rtw crate's [`RtwShadow`].
     #[must_use]
     pub const fn rtw(&self) -> Option<RtwShadow<'_>> {
@@ -208,6 +223,9 @@ impl Fitted {
             Self::Cube(cube) | Self::CubeRtw { cube, .. } => {
                 Some(cube.largest_side()).filter(|side| *side > 0)
             }
+            Self::TiledCube(tiled) => {
+                Some(tiled.atlas[0].max(tiled.atlas[1])).filter(|side| *side > 0)
+            }
             _ => None,
         }
     }
@@ -221,6 +239,7 @@ impl Fitted {
             Self::Dpsm(map) => map.layers() as usize,
             Self::Ipsm(plan) | Self::PointRtw { plan, .. } => plan.map.layers() as usize,
             Self::Cube(cube) | Self::CubeRtw { cube, .. } => cube.faces.len(),
+            Self::TiledCube(tiled) => tiled.tiles.len(),
             _ => 1,
         };
         u32::try_from(count).unwrap_or(u32::MAX)
@@ -278,6 +297,7 @@ impl ShadowMapping for Shadow {
             Fitted::Dpsm(map) => map.map_point(world),
             Fitted::Ipsm(plan) => plan.map.map_point(world),
             Fitted::Cube(cube) => cube.map_point(world),
+            Fitted::TiledCube(tiled) => tiled.map_point(world),
             Fitted::CubeRtw { cube, warps } => {
                 let s = cube.map_point(world)?;
                 warps.get(s.layer as usize)?.warp_sample(s)

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 use shadowmap_frustum::Light;
-use shadowmap_paraboloid::{ConeFit, CubeOptions, IpsmOptions, MapOptions};
+use shadowmap_paraboloid::{ConeFit, CubeOptions, IpsmOptions, MapOptions, TileOptions};
 use shadowmap_rtw::{ImportanceOptions, WarpOptions};
 use shadowmap_warp::{
     LispsmOptions, SpotWarpKind, SpotWarpOptions, TsmOptions, UniformOptions, XpsmOptions,
@@ -117,6 +117,17 @@ pub enum Technique {
         cube: CubeOptions,
         /// The warp.
         rtw: RtwPlan,
+    },
+    /// Tiled cube maps (Arvo's tiled shadow maps over the focused faces): each kept
+    /// face narrowed to the eye samples it stores and cut into a grid of tiles, each
+    /// tile's resolution from the needs of the samples in it, all tiles in one atlas
+    /// of the budget. Point light.
+    TiledCube {
+        /// The cube's faces and focusing (its budget and face sizes are set by the
+        /// fit).
+        cube: CubeOptions,
+        /// The grid and the tiles' guard border.
+        tiles: TileOptions,
     },
 }
 
@@ -358,6 +369,7 @@ impl Technique {
             Self::SpotRtw(_) => "spot_rtw",
             Self::PointRtw { .. } => "point_rtw",
             Self::CubeRtw { .. } => "cube_rtw",
+            Self::TiledCube { .. } => "cube_tiled",
         }
     }
 
@@ -370,7 +382,8 @@ impl Technique {
             | Self::Ipsm(_)
             | Self::CubeMaps(_)
             | Self::PointRtw { .. }
-            | Self::CubeRtw { .. } => LightKind::Point,
+            | Self::CubeRtw { .. }
+            | Self::TiledCube { .. } => LightKind::Point,
             _ => LightKind::Directional,
         }
     }

@@ -25,8 +25,8 @@
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
 use shadowmap::paraboloid::{
-    ConeFit, CubeMap, CubeOptions, FaceSizes, IpsmOptions, Side, SubdivisionOptions,
-    subdivide_triangles,
+    ConeFit, CubeMap, CubeOptions, FaceSizes, IpsmOptions, Side, SubdivisionOptions, TileOptions,
+    TiledCube, subdivide_triangles,
 };
 use shadowmap::rtw::{
     EyeSample, RtwSubdivision, WarpMaps, subdivide_for_rtw, subdivide_for_rtw_clipped,
@@ -119,11 +119,14 @@ pub enum TechniqueKind {
     /// importance from the eye's samples, the faces sized by the error their warps
     /// leave.
     CubeRtw,
+    /// Tiled cube maps: each focused face cut into a grid of tiles, each tile's
+    /// resolution from the needs of the eye's samples in it, one atlas.
+    CubeTiled,
 }
 
 impl TechniqueKind {
     /// All techniques, in report order.
-    pub const ALL: [Self; 21] = [
+    pub const ALL: [Self; 22] = [
         Self::UniformFocused,
         Self::StableCascades,
         Self::TightCascades,
@@ -145,6 +148,7 @@ impl TechniqueKind {
         Self::SpotRtw,
         Self::PointRtw,
         Self::CubeRtw,
+        Self::CubeTiled,
     ];
 
     /// The technique this one must not lose to, of its own family: the uniform fit
@@ -167,7 +171,7 @@ impl TechniqueKind {
             Self::SpotLispsm | Self::SpotTsm | Self::SpotRtw => Some(Self::SpotFit),
             Self::IpsmPaper | Self::IpsmExact | Self::PointRtw => Some(Self::Dpsm),
             Self::Cube => Some(Self::CubeUnfocused),
-            Self::CubeRtw => Some(Self::Cube),
+            Self::CubeRtw | Self::CubeTiled => Some(Self::Cube),
             Self::UniformFocused
             | Self::RtwOracle
             | Self::SpotFit
@@ -211,6 +215,7 @@ impl TechniqueKind {
             Self::SpotRtw => "spot_rtw",
             Self::PointRtw => "point_rtw",
             Self::CubeRtw => "cube_rtw",
+            Self::CubeTiled => "cube_tiled",
         }
     }
 
@@ -261,6 +266,10 @@ impl TechniqueKind {
             Self::CubeRtw => T::CubeRtw {
                 cube: CubeOptions::default(),
                 rtw,
+            },
+            Self::CubeTiled => T::TiledCube {
+                cube: CubeOptions::default(),
+                tiles: TileOptions::default(),
             },
             Self::SpotRtw => T::SpotRtw(rtw),
             Self::PointRtw => T::PointRtw {
@@ -467,6 +476,10 @@ impl Technique {
         if let Some(cube) = self.shadow.cube() {
             return cube.faces.iter().map(|f| (f.size[0], f.size[1])).collect();
         }
+        if let Some(tiled) = self.shadow.tiled_cube() {
+            let stored = |t: &shadowmap::paraboloid::CubeTile| t.side + 2 * tiled.border;
+            return tiled.tiles.iter().map(|t| (stored(t), stored(t))).collect();
+        }
         let side = self.shadow.layer_side();
         vec![(side, side); self.layers() as usize]
     }
@@ -512,6 +525,7 @@ impl Technique {
             Fitted::Cascades(set) => rasterize_depth(mesh, &MatrixProjector::from(set), &options),
             Fitted::Cube(cube) => rasterize_cube(cube, None, mesh, &options),
             Fitted::CubeRtw { cube, warps } => rasterize_cube(cube, Some(warps), mesh, &options),
+            Fitted::TiledCube(tiled) => rasterize_tiles(tiled, mesh, &options),
             Fitted::WarpedCascades { cascades, .. } => {
                 let matrices = cascades
                     .cascades
@@ -617,6 +631,36 @@ fn rasterize_cube(
         });
     }
     DepthMap::from_layers(faces)
+}
+
+/// The tiles of a tiled cube map, one layer each, each rendered through its face's
+/// projection cropped to the tile (as the GPU pass draws each tile into its square
+/// of the atlas).
+fn rasterize_tiles(
+    tiled: &TiledCube,
+    mesh: &Mesh,
+    options: &RasterOptions,
+) -> Result<DepthMap, EvalError> {
+    let reversed_z = tiled.cube.reversed_z;
+    let mut tiles = Vec::with_capacity(tiled.tiles.len());
+    for index in 0..tiled.tiles.len() {
+        let (Some(clip), Some((_, side))) = (
+            tiled.tile_clip_from_world(index),
+            tiled.tile_viewport(index),
+        ) else {
+            return Err(EvalError::Technique {
+                technique: "cube_tiled",
+                reason: "a tile without a projection".into(),
+            });
+        };
+        let projector = MatrixProjector::new(vec![clip.as_dmat4()], reversed_z);
+        tiles.push(rasterize_depth(
+            mesh,
+            &projector,
+            &options.with_size(side, side),
+        )?);
+    }
+    DepthMap::from_layers(tiles)
 }
 
 /// A mesh of `f32` triangles.

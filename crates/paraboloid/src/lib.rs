@@ -25,7 +25,9 @@
 //!   `shadowmap-wgpu`);
 //! - [`CubeMap`]: cube shadow maps, what engines ship for point lights and the
 //!   baseline the paraboloid maps are measured against: the faces that see visible
-//!   receivers, each focused on them (see [Cube maps](#cube-maps)).
+//!   receivers, each focused on them (see [Cube maps](#cube-maps));
+//! - [`TiledCube`]: cube maps whose faces are cut into tiles sized by need, in one
+//!   atlas (see [Tiled cube maps](#tiled-cube-maps)).
 //!
 //! # Example
 //!
@@ -286,13 +288,13 @@
 //! equal full faces, what engines render; RTW over the focused faces is the
 //! umbrella's `CubeRtw`):
 //!
-//! | configuration | DPSM | IPSM exact | cube, by need | cube, equal full faces | RTW over the faces |
-//! |---|---|---|---|---|---|
-//! | `point_near` | 4.73 | 2.62 | 1.90 (5 faces) | 2.46 | 1.19 |
-//! | `point_mid` | 28.9 | 13.2 | 7.48 (5 faces) | 18.6 | 1.69 |
-//! | `point_far` | 115 | 55.7 | 27.2 (5 faces) | 97.2 | 2.68 |
-//! | `point_inside` | 5.02 | 4.56 | 5.04 (6 faces) | 5.42 | 1.06 |
-//! | `facing_point` | 18.4 | 15.5 | 11.9 (6 faces) | 23.7 | 1.91 |
+//! | configuration | DPSM | IPSM exact | cube, by need | cube, equal full faces | RTW over the faces | tiled |
+//! |---|---|---|---|---|---|---|
+//! | `point_near` | 4.73 | 2.62 | 1.90 (5 faces) | 2.46 | 1.19 | 0.83 |
+//! | `point_mid` | 28.9 | 13.2 | 7.48 (5 faces) | 18.6 | 1.69 | 2.15 |
+//! | `point_far` | 115 | 55.7 | 27.2 (5 faces) | 97.2 | 2.68 | 3.75 |
+//! | `point_inside` | 5.02 | 4.56 | 5.04 (6 faces) | 5.42 | 1.06 | 1.68 |
+//! | `facing_point` | 18.4 | 15.5 | 11.9 (6 faces) | 23.7 | 1.91 | 2.09 |
 //!
 //! With the light among the visible receivers every face is kept, and six equal maps
 //! of `1024² / 6` texels lose to a DPSM's two of `1024² / 2` (1.08 and 1.29 times its
@@ -301,6 +303,59 @@
 //! (`cargo bench --bench paraboloid -- cube_fit`: about 8 times an exact IPSM plan on
 //! the shared development machine); sizing by the prediction on the receivers' box
 //! casts a grid of 24 x 14 view rays on top.
+//!
+//! # Tiled cube maps
+//!
+//! A face's texels all have one size, and a warp of the face (RTW) moves them only
+//! by whole rows and columns, so the texels a row needs for its nearest receiver are
+//! spent along the whole row. [`TiledCube`] (Arvo, *Tiled Shadow Maps*, CGI 2004;
+//! current engines' virtual shadow maps choose each page's resolution the same way)
+//! cuts each kept face into `grid x grid` cells ([`TileOptions`]), gives each cell
+//! as many texels per unit of `uv` as the caller says it needs (the umbrella's
+//! `TiledCube` technique: the 95th percentile of its eye samples' needs), groups
+//! four neighbours into one tile where that costs no more texels (a quadtree: a
+//! uniform region pays one guard border, not one per cell) and packs the tiles into
+//! one nearly square atlas whose square fits the budget. Each tile renders its
+//! face's projection cropped to it ([`TiledCube::tile_clip_from_world`]) into its
+//! square ([`TiledCube::tile_viewport`]); a point maps through its face, its cell
+//! ([`TiledCube::table`]) and its tile, the tile being the sample's layer
+//! ([`TiledCube::atlas_sample`] gives the atlas coordinates). Where the light is near
+//! the eye (`point_near` above) the tiles need 0.44 times the focused cube's error;
+//! where the need varies smoothly along rows and columns (a light far down the
+//! street), RTW's warp of the whole face does better.
+//!
+//! ```
+//! use glam::{DVec2, DVec3, Vec3};
+//! use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds, ShadowMapping};
+//! use shadowmap_paraboloid::{CubeMap, CubeOptions, TileOptions, TiledCube};
+//!
+//! let camera = Camera::look_to(
+//!     Vec3::new(0.0, 2.0, 0.0),
+//!     Vec3::NEG_Z,
+//!     Vec3::Y,
+//!     Projection::perspective(60f32.to_radians(), 16.0 / 9.0, 0.1, 200.0),
+//! )?;
+//! let light = Light::Point { position: Vec3::new(0.0, 8.0, -20.0), range: 100.0 };
+//! let ground = Aabb::new(Vec3::new(-100.0, -0.5, -200.0), Vec3::new(100.0, 0.0, 10.0));
+//! let scene = SceneBounds::new(ground, Aabb::new(ground.min, ground.max + 10.0 * Vec3::Y));
+//! let cube = CubeMap::fit(&light, &camera, None, &scene, &CubeOptions::default())?;
+//!
+//! // Each cell's need (texels per unit of face uv): here the upper half of every
+//! // face four times the lower half's.
+//! let options = TileOptions::default().with_grid(8);
+//! let cells = (cube.layers() * 64) as usize;
+//! let needs: Vec<f64> = (0..cells).map(|i| if i % 64 < 32 { 800.0 } else { 200.0 }).collect();
+//! let tiled = TiledCube::new(cube, &options, &needs, 512 * 512)?;
+//! assert!(tiled.texels() <= 512 * 512);
+//! // Uniform halves merge into few tiles; the upper ones are four times as wide.
+//! assert!(tiled.tiles.len() < cells);
+//! let s = tiled.map_point(DVec3::new(3.0, 0.0, -30.0)).expect("covered");
+//! let tile = tiled.tiles[s.layer as usize];
+//! assert!((0.0..=1.0).contains(&s.uv.x) && (0.0..=1.0).contains(&s.uv.y));
+//! let atlas = tiled.atlas_sample(s).unwrap();
+//! assert!(atlas.uv.cmple(DVec2::ONE).all() && tile.side >= 1);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 //!
 //! Errors ([`ParaboloidError`]): as the other builders for non-finite input, a bad
 //! near option or depth range, and a directional light;
@@ -312,7 +367,8 @@
 //! # Features
 //!
 //! `std` (default) or `libm` provide float math; with `libm` and without `std` the
-//! crate is `no_std` (it uses `alloc` only for [`subdivide_triangles`]). The plan
+//! crate is `no_std` (it uses `alloc` only for [`subdivide_triangles`] and the tiles of
+//! [`TiledCube`]). The plan
 //! allocates nothing.
 //!
 //! Optional data features, `no_std` compatible: `serde` (`Serialize` and
@@ -329,6 +385,7 @@ mod cone;
 mod cube;
 mod cube_fit;
 mod cube_sizes;
+mod cube_tiles;
 mod error;
 mod map;
 mod orient;
@@ -340,6 +397,7 @@ mod subdivide;
 pub use cone::{Cone, ConeFit, MAX_CONE_DIRECTIONS, MIN_ZOOM, fit_minimal_cone, fit_paper_cone};
 pub use cube::{CubeFace, CubeFaceId, CubeMap, CubeOptions};
 pub use cube_sizes::{FaceSizes, MIN_ASPECT, MIN_SIDE_RATIO};
+pub use cube_tiles::{CubeTile, MAX_TILE_BORDER, MAX_TILE_GRID, TileOptions, TiledCube};
 pub use error::ParaboloidError;
 pub use map::{MapOptions, ParaboloidMap, ParaboloidMode, ParaboloidUniform, Side, UsableDisc};
 pub use plan::{DualReason, IpsmOptions, IpsmPlan};

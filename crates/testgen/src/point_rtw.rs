@@ -1,11 +1,11 @@
 //! Generators and checks for RTW over the IPSM paraboloid and over the cube map's
-//! faces (fitted by the umbrella crate's `fit`; the fuzz target and the property
+//! faces, and for tiled cube maps (fitted by the umbrella crate's `fit`; the fuzz targets and the property
 //! tests pass the fitted mapping in).
 
 use arbitrary::Unstructured;
 use glam::DVec2;
 use shadowmap_frustum::ShadowMapping;
-use shadowmap_paraboloid::{CubeMap, ParaboloidMap};
+use shadowmap_paraboloid::{CubeMap, ParaboloidMap, TiledCube};
 use shadowmap_rtw::EyeSample;
 
 use crate::cube::{CubeInput, cube_input, near_floor, visible_points};
@@ -165,4 +165,116 @@ pub fn check_cube_samples(
         checked += 1;
     }
     Ok(checked)
+}
+
+/// A tiled cube map fitted to a case's samples (`tiled`; `mapping`, the fitted
+/// technique's lookup) covers every sample its cube covers (the clauses of
+/// [`check_cube_samples`] on the cube's windows): `mapping` maps it into the tile of
+/// its face and cell, inside the tile's `[0, 1]²`, at the cube's depth; the tile's
+/// place in the atlas lies within the tile's square and the atlas; the tiles' squares
+/// are disjoint and inside an atlas of at most `budget` texels. Returns how many
+/// samples were checked.
+///
+/// # Errors
+/// A description of the violated clause.
+pub fn check_tiled_samples(
+    case: &CubeSamplesCase,
+    tiled: &TiledCube,
+    mapping: &impl ShadowMapping,
+    budget: u64,
+) -> Result<usize, String> {
+    if tiled.texels() > budget || tiled.atlas.contains(&0) {
+        return Err(format!("atlas {:?} over {budget}", tiled.atlas));
+    }
+    check_tiles_apart(tiled)?;
+    check_table(tiled)?;
+    let tol = 1e-4;
+    let inside =
+        |uv: DVec2| uv.cmpge(DVec2::splat(-tol)).all() && uv.cmple(DVec2::splat(1.0 + tol)).all();
+    let mut checked = 0;
+    for s in &case.samples {
+        let p = s.position.as_dvec3();
+        let Some(c) = tiled.cube.map_point(p) else {
+            continue;
+        };
+        let index = tiled
+            .tile_index(c.layer, c.uv)
+            .ok_or("a face without tiles")?;
+        let m = mapping
+            .map_point(p)
+            .ok_or_else(|| format!("sample {} stored by the cube, not by the tiles", s.position))?;
+        if m.layer as usize != index || !(m.uv.is_finite() && inside(m.uv)) || m.depth != c.depth {
+            return Err(format!("sample {}: cube {c:?}, tiles {m:?}", s.position));
+        }
+        let a = tiled.atlas_sample(m).ok_or("no atlas sample")?;
+        let (offset, side) = tiled.tile_viewport(index).ok_or("no viewport")?;
+        let atlas = DVec2::new(f64::from(tiled.atlas[0]), f64::from(tiled.atlas[1]));
+        let texel = a.uv * atlas;
+        let lo = DVec2::new(f64::from(offset[0]), f64::from(offset[1]));
+        let hi = lo + f64::from(side);
+        if !(texel.cmpge(lo - tol).all() && texel.cmple(hi + tol).all()) {
+            return Err(format!("texel {texel} outside its tile {lo}..{hi}"));
+        }
+        checked += 1;
+    }
+    Ok(checked)
+}
+
+/// Every cell of every kept face has an entry, and it names a tile of that face
+/// whose cells hold it.
+fn check_table(tiled: &TiledCube) -> Result<(), String> {
+    let g = tiled.grid;
+    let cells = tiled.cube.faces.len() * (g * g) as usize;
+    if tiled.table.len() != cells {
+        return Err(format!("{} entries for {cells} cells", tiled.table.len()));
+    }
+    for (i, &entry) in tiled.table.iter().enumerate() {
+        let (layer, row, col) = ((i as u32) / (g * g), (i as u32 % (g * g)) / g, i as u32 % g);
+        let t = tiled
+            .tiles
+            .get(entry as usize)
+            .ok_or("entry past the tiles")?;
+        let holds = (t.cell[0]..t.cell[0] + t.span).contains(&col)
+            && (t.cell[1]..t.cell[1] + t.span).contains(&row);
+        if t.layer != layer || !holds {
+            return Err(format!("cell {layer}/{row}/{col} in tile {t:?}"));
+        }
+    }
+    Ok(())
+}
+
+/// The tiles' squares (border included) lie inside the atlas and overlap nowhere.
+fn check_tiles_apart(tiled: &TiledCube) -> Result<(), String> {
+    let [w, h] = tiled.atlas.map(u64::from);
+    let mut rects: Vec<[u64; 4]> = Vec::with_capacity(tiled.tiles.len());
+    for i in 0..tiled.tiles.len() {
+        let (o, side) = tiled.tile_viewport(i).ok_or("no viewport")?;
+        let r = [
+            u64::from(o[0]),
+            u64::from(o[1]),
+            u64::from(side),
+            u64::from(side),
+        ];
+        if side == 0 || r[0] + r[2] > w || r[1] + r[3] > h {
+            return Err(format!("tile {i} {r:?} outside the atlas {w}x{h}"));
+        }
+        rects.push(r);
+    }
+    // Sweep by rows: sort by top edge, compare with the tiles that start above
+    // this one's bottom.
+    let mut order: Vec<usize> = (0..rects.len()).collect();
+    order.sort_by_key(|i| rects[*i][1]);
+    for (k, &i) in order.iter().enumerate() {
+        let a = rects[i];
+        for &j in &order[k + 1..] {
+            let b = rects[j];
+            if b[1] >= a[1] + a[3] {
+                break;
+            }
+            if a[0] < b[0] + b[2] && b[0] < a[0] + a[2] {
+                return Err(format!("tiles {i} {a:?} and {j} {b:?} overlap"));
+            }
+        }
+    }
+    Ok(())
 }

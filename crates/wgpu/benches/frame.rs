@@ -462,7 +462,9 @@ fn ipsm_frame_cpu(c: &mut Criterion) {
 /// clipped to each face's window and refined on the GPU, the depth pass drawn
 /// indirectly, uploads flushed; and the fit before it (`cube_rtw_fit`: the oracle's
 /// needs of a 480x270 ground G-buffer, one pair of 256-cell tables per face), with
-/// the cube maps sized by the same samples' needs beside it (`cube_fit_by_need`).
+/// the cube maps sized by the same samples' needs beside it (`cube_fit_by_need`),
+/// and tiled cube maps' fit and depth-pass blocks (`cube_tiled_fit`,
+/// `cube_tiled_uniforms`).
 fn cube_rtw_frame_cpu(c: &mut Criterion) {
     let cam = camera();
     let lamp = Light::Point {
@@ -492,6 +494,24 @@ fn cube_rtw_frame_cpu(c: &mut Criterion) {
     c.bench_function("cube_fit_by_need/city_block_lamp_2048", |b| {
         b.iter(|| black_box(fit(black_box(&by_need), &input).is_ok()));
     });
+    // Tiled cube maps on the same input: the fit (the samples' isotropic needs per
+    // cell, the quadtree, the packing) and the blocks of its depth pass and lookup.
+    let tiled = Technique::TiledCube {
+        cube: Default::default(),
+        tiles: Default::default(),
+    };
+    c.bench_function("cube_tiled_fit/city_block_lamp_2048", |b| {
+        b.iter(|| black_box(fit(black_box(&tiled), &input).is_ok()));
+    });
+    if let Some(t) = fit(&tiled, &input)
+        .ok()
+        .as_ref()
+        .and_then(Shadow::tiled_cube)
+    {
+        c.bench_function("cube_tiled_uniforms/city_block_lamp_2048", |b| {
+            b.iter(|| black_box(shadowmap_wgpu::tiles::tiled_uniforms(black_box(t), 2048)));
+        });
+    }
     let shadow = fit(&technique, &input).expect("cube_rtw");
     let Fitted::CubeRtw { cube, warps } = shadow.fitted() else {
         return;

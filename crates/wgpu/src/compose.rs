@@ -136,6 +136,11 @@ pub fn composed_shaders() -> Vec<(&'static str, Result<String, BackendError>)> {
         (LOOKUP_RTW, FILTER_PCF),
         (LOOKUP_RTW, FILTER_POISSON),
         (LOOKUP_RTW, FILTER_VSM),
+        (LOOKUP_TILES, FILTER_HARD),
+        (LOOKUP_TILES, FILTER_HARDWARE),
+        (LOOKUP_TILES, FILTER_PCF),
+        (LOOKUP_TILES, FILTER_POISSON),
+        (LOOKUP_TILES, FILTER_VSM),
     ];
     let mut out: Vec<_> = all
         .iter()

@@ -202,6 +202,7 @@ mod mesh;
 pub mod profile;
 pub mod render;
 pub mod shadow;
+pub mod tiles;
 pub mod uniforms;
 
 // --- compute passes: depth reduction, RTW pipeline (another author) ---
@@ -243,6 +244,8 @@ pub mod shaders {
     /// tables, the layer's corner); its table sampler is a
     /// placeholder until composed ([`crate::compose::lookup_rtw`]).
     pub const LOOKUP_RTW: &str = include_str!("../shaders/lookup_rtw.wgsl");
+    /// Lookup of a tiled cube map: face, cell, tile, the tile's square of the atlas.
+    pub const LOOKUP_TILES: &str = include_str!("../shaders/lookup_tiles.wgsl");
     /// The RTW warp-table sampler, composed into the RTW depth pass and lookup.
     pub const RTW_SAMPLE: &str = include_str!("../shaders/rtw_sample.wgsl");
     /// Filter: one nearest texel.

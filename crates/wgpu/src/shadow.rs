@@ -84,6 +84,7 @@ pub fn with_technique<R>(
         (Fitted::WarpedCascades { cascades, .. }, _) => ShadowTechnique::WarpedCascades(cascades),
         (Fitted::Cube(cube), _) => ShadowTechnique::Cube(cube),
         (Fitted::CubeRtw { cube, warps }, _) => ShadowTechnique::CubeRtw { cube, warps },
+        (Fitted::TiledCube(tiled), _) => ShadowTechnique::TiledCube(tiled),
         _ => return Err(UNSUPPORTED),
     };
     Ok(f(&technique))

@@ -3,7 +3,8 @@
 //! rasterizer of `shadowmap-eval`, with the tolerance of the
 //! other depth tests: at most 0.1% of texels differ by more than 1e-4 in depth; and
 //! a frame rendered through `render_shadow` (depth pass and face lookup) shadows what
-//! a DPSM of the same light shadows.
+//! a DPSM of the same light shadows. Tiled cube maps: every tile's square of the
+//! GPU atlas matches the CPU rasterizer's map of the tile.
 
 use glam::Vec3;
 use shadowmap::Fitted;
@@ -55,6 +56,27 @@ fn lamp_among_buildings() -> (Scene, Vec<[Vec3; 3]>, Camera, Light) {
         range: 400.0,
     };
     (scene, tris, camera, lamp)
+}
+
+/// `kind` fitted with 384² texels to the lamp among the buildings, on the eye
+/// samples of a 320x240 G-buffer traced on the CPU; with the scene and its triangles.
+fn fitted_among_buildings(kind: TechniqueKind) -> (Scene, Vec<[Vec3; 3]>, EvalTechnique) {
+    let (scene, tris, camera, lamp) = lamp_among_buildings();
+    let (width, height) = (320, 240);
+    let bvh = Bvh::build(&scene.mesh).unwrap();
+    let gbuffer = GBuffer::trace(&bvh, &camera, width, height).unwrap();
+    let samples = eye_samples(&gbuffer, &camera);
+    let screen = ScreenGeometry::new(&camera, width, height).unwrap();
+    let frame = FrameContext {
+        camera: &camera,
+        light: &lamp,
+        scene: scene.scene_bounds().unwrap(),
+        eye_samples: &samples,
+        pixels_per_radian: screen.pixels_per_radian().unwrap() as f32,
+    };
+    let options = TechniqueOptions::default().with_texel_budget(384 * 384);
+    let technique = EvalTechnique::build(kind, &frame, &options).unwrap();
+    (scene, tris, technique)
 }
 
 /// The matrix depth pass of `raws` over `tris`, read back.
@@ -280,21 +302,7 @@ fn warped_cube_faces_match_the_cpu_reference() {
     else {
         return;
     };
-    let (scene, tris, camera, lamp) = lamp_among_buildings();
-    let (width, height) = (320, 240);
-    let bvh = Bvh::build(&scene.mesh).unwrap();
-    let gbuffer = GBuffer::trace(&bvh, &camera, width, height).unwrap();
-    let samples = eye_samples(&gbuffer, &camera);
-    let screen = ScreenGeometry::new(&camera, width, height).unwrap();
-    let frame = FrameContext {
-        camera: &camera,
-        light: &lamp,
-        scene: scene.scene_bounds().unwrap(),
-        eye_samples: &samples,
-        pixels_per_radian: screen.pixels_per_radian().unwrap() as f32,
-    };
-    let options = TechniqueOptions::default().with_texel_budget(384 * 384);
-    let technique = EvalTechnique::build(TechniqueKind::CubeRtw, &frame, &options).unwrap();
+    let (scene, tris, technique) = fitted_among_buildings(TechniqueKind::CubeRtw);
     let Fitted::CubeRtw { cube, warps } = technique.shadow().fitted() else {
         panic!("cube_rtw fits a cube map with tables");
     };
@@ -353,4 +361,67 @@ fn warped_cube_faces_match_the_cpu_reference() {
     let fraction = differing as f64 / compared as f64;
     eprintln!("cube_rtw (side {side}): {differing} of {compared} texels differ ({fraction:.5})");
     assert!(fraction <= 1e-3, "{differing} of {compared} texels differ");
+}
+
+/// Tiled cube maps (`cube_tiled`): every tile drawn through its cropped face
+/// projection into its square of the atlas (one matrix pass, a viewport per tile)
+/// matches eval's reference, which rasterizes each tile on its own at its stored
+/// side, within the tolerance of the other depth tests; texels between the tiles
+/// stay clear.
+#[test]
+fn tiled_cube_atlas_matches_the_cpu_reference() {
+    let Some(ctx) =
+        shadowmap_wgpu::context::test_context("tiled_cube_atlas_matches_the_cpu_reference")
+    else {
+        return;
+    };
+    let (scene, tris, technique) = fitted_among_buildings(TechniqueKind::CubeTiled);
+    let tiled = technique.shadow().tiled_cube().expect("a tiled cube map");
+    assert!(tiled.tiles.len() > 20, "{} tiles", tiled.tiles.len());
+    let cpu = technique
+        .rasterize(&scene.mesh, &RasterOptions::default())
+        .unwrap();
+    let side = technique.shadow().layer_side();
+    let uniforms = shadowmap_wgpu::tiles::tiled_uniforms(tiled, side);
+    let gpu = ctx
+        .scoped(|ctx| {
+            let mesh = MeshBuffers::from_triangles(ctx, &tris)?;
+            let desc = DepthPassDesc::new(DepthTechnique::Matrix, side);
+            let mut pass = ShadowDepthPass::new(ctx, &desc)?;
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            pass.encode_tiles(ctx, &mut encoder, &mesh, &uniforms.draws)?;
+            ctx.queue.submit([encoder.finish()]);
+            pass.readback_depth(ctx)
+        })
+        .expect("GPU depth pass");
+    let (mut differing, mut compared, mut offset) = (0, 0, 0);
+    let mut covered = vec![false; gpu.len()];
+    for (layer, draw) in uniforms.draws.iter().enumerate() {
+        let s = draw.side as usize;
+        assert_eq!(cpu.layer_size(layer as u32), (draw.side, draw.side));
+        for row in 0..s {
+            for col in 0..s {
+                let at =
+                    (draw.offset[1] as usize + row) * side as usize + draw.offset[0] as usize + col;
+                covered[at] = true;
+                let c = cpu.depth[offset + row * s + col];
+                differing += usize::from((gpu[at] - c).abs() > 1e-4);
+            }
+        }
+        compared += s * s;
+        offset += s * s;
+    }
+    let fraction = differing as f64 / compared as f64;
+    eprintln!(
+        "cube_tiled ({} tiles, atlas {:?} in {side}): {differing} of {compared} texels differ ({fraction:.5})",
+        uniforms.draws.len(),
+        tiled.atlas
+    );
+    assert!(fraction <= 1e-3, "{differing} of {compared} texels differ");
+    let stray = gpu
+        .iter()
+        .zip(&covered)
+        .filter(|(d, c)| !**c && **d != 1.0)
+        .count();
+    assert_eq!(stray, 0, "texels drawn outside every tile");
 }

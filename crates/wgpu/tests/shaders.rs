@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 
 /// The techniques a `// techniques:` header may name, besides `any`.
-const TECHNIQUES: [&str; 7] = [
+const TECHNIQUES: [&str; 8] = [
     "uniform",
     "cascades",
     "lispsm",
@@ -18,6 +18,7 @@ const TECHNIQUES: [&str; 7] = [
     "tsm",
     "paraboloid",
     "rtw",
+    "tiles",
 ];
 
 fn shader_dir() -> PathBuf {
@@ -87,7 +88,7 @@ fn composed_sources() -> Vec<(&'static str, Result<String, shadowmap_wgpu::Backe
 
 /// Lookups times filters the renderer composes, the RTW and paraboloid depth passes
 /// and the refinement.
-const COMPOSITIONS: usize = 4 * 5 + 3;
+const COMPOSITIONS: usize = 5 * 5 + 3;
 
 #[test]
 fn every_shader_file_parses_and_validates() {

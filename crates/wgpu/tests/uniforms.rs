@@ -177,6 +177,21 @@ fn rtw_and_frame_blocks_match() {
 }
 
 #[test]
+fn tiled_lookup_block_matches() {
+    use shadowmap_wgpu::tiles::TiledLookupRaw;
+    check(
+        shaders::LOOKUP_TILES,
+        "TiledShadow",
+        size_of::<TiledLookupRaw>(),
+        &[
+            ("uv_from_world", offset_of!(TiledLookupRaw, uv_from_world)),
+            ("counts", offset_of!(TiledLookupRaw, counts)),
+            ("params", offset_of!(TiledLookupRaw, params)),
+        ],
+    );
+}
+
+#[test]
 fn to_raw_copies_the_math_crates_outputs() {
     let camera = Camera::look_to(
         Vec3::new(0.0, 2.0, 0.0),

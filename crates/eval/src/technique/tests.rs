@@ -37,7 +37,7 @@ fn every_light_has_techniques() {
         range: 10.0,
     };
     assert_eq!(TechniqueKind::for_light(&d).len(), 10);
-    assert_eq!(TechniqueKind::for_light(&p).len(), 7);
+    assert_eq!(TechniqueKind::for_light(&p).len(), 8);
     assert!(!TechniqueKind::SpotFit.applies_to(&d));
 }
 
@@ -167,7 +167,7 @@ fn wrong_light_or_bad_frame_is_a_typed_error() {
 }
 
 /// Cube maps (by need, equal full faces, and RTW over the faces) render one layer
-/// per kept face at its own side within the budget, and a box over the ground
+/// per kept face (tiled: per tile) at its own side within the budget, and a box over the ground
 /// shadows the ground point below it (on its own layer) but not a lit one.
 #[test]
 fn cube_maps_render_their_kept_faces() {
@@ -217,17 +217,27 @@ fn cube_maps_render_their_kept_faces() {
         TechniqueKind::Cube,
         TechniqueKind::CubeUnfocused,
         TechniqueKind::CubeRtw,
+        TechniqueKind::CubeTiled,
     ] {
         let t = Technique::build(kind, &frame, &o).unwrap();
-        let cube = t.shadow().cube().unwrap();
-        assert!((1..6).contains(&t.layers()), "{}", t.layers());
-        assert_eq!(t.layers(), cube.layers());
         assert!(
             t.texels() <= budget && t.texels() >= budget * 3 / 4,
             "{}",
             t.texels()
         );
-        let sides: Vec<(u32, u32)> = cube.faces.iter().map(|f| (f.size[0], f.size[1])).collect();
+        let sides: Vec<(u32, u32)> = if let Some(tiled) = t.shadow().tiled_cube() {
+            let stored = |side: u32| side + 2 * tiled.border;
+            tiled
+                .tiles
+                .iter()
+                .map(|x| (stored(x.side), stored(x.side)))
+                .collect()
+        } else {
+            let cube = t.shadow().cube().unwrap();
+            assert!((1..6).contains(&t.layers()), "{}", t.layers());
+            assert_eq!(t.layers(), cube.layers());
+            cube.faces.iter().map(|f| (f.size[0], f.size[1])).collect()
+        };
         assert_eq!(t.layer_sizes(), sides);
         let map = t.rasterize(&mesh, &RasterOptions::default()).unwrap();
         assert_eq!(map.layers, t.layers());

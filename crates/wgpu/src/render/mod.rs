@@ -209,7 +209,7 @@ impl HeadlessRenderer {
         };
         let inputs = SceneInputs {
             frame,
-            lookup: technique.lookup_bytes(view.view_from_world),
+            lookup: technique.lookup_bytes(view.view_from_world, options.shadow_resolution),
             tables: &output.tables,
             depth,
             moments: &moments,

@@ -13,6 +13,7 @@ use crate::depth::{
 };
 use crate::profile::GpuProfiler;
 use crate::refine::RefineOptions;
+use crate::tiles::tiled_uniforms;
 use crate::uniforms::{
     FrameRaw, RtwShadowRaw, ToRaw, paraboloid_layers, warped_cube, warped_paraboloid,
 };
@@ -71,6 +72,18 @@ impl DepthJob<'_> {
             return Ok(DepthOutput {
                 pass: index,
                 tables: LookupTables::None,
+            });
+        }
+        if let ShadowTechnique::TiledCube(tiled) = technique {
+            let uniforms = tiled_uniforms(tiled, self.options.shadow_resolution);
+            let index = cache.pass_index(ctx, &self.desc(DepthTechnique::Matrix, 1))?;
+            let (pass, mesh, _) = cache.parts(ctx, index, None)?;
+            timed(profiler, encoder, "depth", |e| {
+                pass.encode_tiles(ctx, e, mesh, &uniforms.draws)
+            })?;
+            return Ok(DepthOutput {
+                pass: index,
+                tables: LookupTables::Owned(uniforms.data),
             });
         }
         let refine = RefineOptions::default()

@@ -146,7 +146,7 @@ fn scene_layouts(device: &wgpu::Device, lookup: Lookup) -> [wgpu::BindGroupLayou
     });
     // The block size depends on the technique: no minimum.
     let mut lookup_entries = vec![uniform_entry(0, wgpu::ShaderStages::FRAGMENT, 0)];
-    if matches!(lookup, Lookup::Rtw | Lookup::Paraboloid) {
+    if matches!(lookup, Lookup::Rtw | Lookup::Paraboloid | Lookup::Tiles) {
         lookup_entries.push(wgpu::BindGroupLayoutEntry {
             binding: 1,
             visibility: wgpu::ShaderStages::FRAGMENT,

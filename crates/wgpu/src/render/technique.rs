@@ -3,11 +3,12 @@
 
 use glam::Mat4;
 use shadowmap_frustum::{CascadeSet, LightDirection, ShadowTransform};
-use shadowmap_paraboloid::{CubeMap, ParaboloidMap};
+use shadowmap_paraboloid::{CubeMap, ParaboloidMap, TiledCube};
 use shadowmap_rtw::{RtwShadow, WarpMaps};
 use shadowmap_warp::{WarpedCascades, XpsmShadow};
 
 use crate::rtw::GpuRtw;
+use crate::tiles::tiled_uniforms;
 use crate::uniforms::{
     CascadeShadowRaw, MatrixShadowRaw, ParaboloidLookupRaw, RtwLookupRaw, RtwShadowRaw, ToRaw,
     cascade_layers, cube_layers, warped_cascade_layers, warped_cube, warped_paraboloid,
@@ -76,6 +77,11 @@ pub enum ShadowTechnique<'a> {
         /// is not warped).
         warps: &'a [WarpMaps],
     },
+    /// Tiled cube maps (`shadowmap_paraboloid::TiledCube`): every tile drawn into
+    /// its square of one atlas layer through its face's projection cropped to it
+    /// (render at the atlas's larger side, as `render_shadow` does); the lookup
+    /// selects the face by projection, then the cell's tile.
+    TiledCube(&'a TiledCube),
 }
 
 /// Which lookup shader.
@@ -85,6 +91,7 @@ pub(super) enum Lookup {
     Cascades,
     Paraboloid,
     Rtw,
+    Tiles,
 }
 
 impl Lookup {
@@ -95,6 +102,7 @@ impl Lookup {
             Self::Cascades => Ok(shaders::LOOKUP_CASCADES.to_owned()),
             Self::Paraboloid => compose::lookup_paraboloid(),
             Self::Rtw => compose::lookup_rtw(),
+            Self::Tiles => Ok(shaders::LOOKUP_TILES.to_owned()),
         }
     }
 }
@@ -109,6 +117,7 @@ impl ShadowTechnique<'_> {
             | Self::Cube(_) => Lookup::Cascades,
             Self::Paraboloid(_) | Self::ParaboloidRtw { .. } => Lookup::Paraboloid,
             Self::Rtw(_) | Self::RtwGpu { .. } | Self::CubeRtw { .. } => Lookup::Rtw,
+            Self::TiledCube(_) => Lookup::Tiles,
         }
     }
 
@@ -132,7 +141,8 @@ impl ShadowTechnique<'_> {
             Self::Paraboloid(_)
             | Self::ParaboloidRtw { .. }
             | Self::Cube(_)
-            | Self::CubeRtw { .. } => None,
+            | Self::CubeRtw { .. }
+            | Self::TiledCube(_) => None,
         }
     }
 
@@ -149,6 +159,7 @@ impl ShadowTechnique<'_> {
             Self::Cube(c) | Self::CubeRtw { cube: c, .. } => {
                 Ok(LightDirection::Position(c.position))
             }
+            Self::TiledCube(t) => Ok(LightDirection::Position(t.cube.position)),
             _ => self
                 .first_transform()
                 .map(|t| t.light)
@@ -161,7 +172,7 @@ impl ShadowTechnique<'_> {
     /// stored-depth units near 1 span a distance growing as its square.
     pub(super) fn perspective_depth(&self) -> bool {
         match self {
-            Self::Cube(_) | Self::CubeRtw { .. } => true,
+            Self::Cube(_) | Self::CubeRtw { .. } | Self::TiledCube(_) => true,
             Self::Paraboloid(_) | Self::ParaboloidRtw { .. } => false,
             _ => self
                 .first_transform()
@@ -173,6 +184,7 @@ impl ShadowTechnique<'_> {
         match self {
             Self::Paraboloid(m) | Self::ParaboloidRtw { map: m, .. } => m.reversed_z,
             Self::Cube(c) | Self::CubeRtw { cube: c, .. } => c.reversed_z,
+            Self::TiledCube(t) => t.cube.reversed_z,
             _ => self.first_transform().is_some_and(|t| t.reversed_z),
         }
     }
@@ -190,14 +202,19 @@ impl ShadowTechnique<'_> {
             | Self::ParaboloidRtw { .. }
             | Self::Rtw(_)
             | Self::RtwGpu { .. }
-            | Self::CubeRtw { .. } => None,
+            | Self::CubeRtw { .. }
+            | Self::TiledCube(_) => None,
         }
     }
 
     /// The lookup's uniform block, as bytes; `view_from_world` is the camera's
-    /// (warped cascades select by its view depth).
-    pub(super) fn lookup_bytes(&self, view_from_world: Mat4) -> Vec<u8> {
+    /// (warped cascades select by its view depth), `texture_side` the depth
+    /// texture's (tiled cube maps place the atlas in its corner).
+    pub(super) fn lookup_bytes(&self, view_from_world: Mat4, texture_side: u32) -> Vec<u8> {
         match self {
+            Self::TiledCube(t) => {
+                bytemuck::bytes_of(&tiled_uniforms(t, texture_side).lookup).to_vec()
+            }
             Self::Matrix(t) => bytemuck::bytes_of(&t.to_raw()).to_vec(),
             Self::Xpsm(x) => bytemuck::bytes_of(&x.to_raw()).to_vec(),
             Self::Cascades(s) => bytemuck::bytes_of(&s.to_raw()).to_vec(),
