@@ -110,6 +110,29 @@ fn every_fitted_shadow_round_trips_and_maps_the_same() {
     }
 }
 
+/// Tiled cube maps (tiles, cell table and atlas) round-trip and map every probe the
+/// same.
+#[test]
+fn tiled_cube_maps_round_trip() {
+    let technique = Technique::TiledCube {
+        cube: Default::default(),
+        tiles: Default::default(),
+    };
+    let shadow = fitted(&technique);
+    assert!(shadow.tiled_cube().is_some_and(|t| t.tiles.len() > 1));
+    let json = serde_json::to_string(&shadow).unwrap();
+    let back: Shadow = serde_json::from_str(&json).unwrap();
+    assert_eq!(serde_json::to_string(&back).unwrap(), json);
+    assert_eq!(back.layers(), shadow.layers());
+    for p in [
+        Vec3::new(0.0, 0.5, -20.0),
+        Vec3::new(-3.0, 0.5, -12.0),
+        Vec3::new(4.0, 0.5, -25.0),
+    ] {
+        assert_eq!(back.map_point(p.as_dvec3()), shadow.map_point(p.as_dvec3()));
+    }
+}
+
 #[test]
 fn inconsistent_shadows_are_refused() {
     let shadow = fitted(&Technique::all_default()[0]);

@@ -252,10 +252,10 @@ impl TiledCube {
     }
 
     /// The index of the tile holding face `uv` of `layer` (clamped to the face's
-    /// cells); `None` past the last layer.
+    /// cells); `None` past the last layer or the table (a value read from elsewhere).
     #[must_use]
     pub fn tile_index(&self, layer: u32, uv: DVec2) -> Option<usize> {
-        if layer >= self.cube.layers() {
+        if layer >= self.cube.layers() || self.grid == 0 {
             return None;
         }
         let g = f64::from(self.grid);
