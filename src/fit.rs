@@ -489,7 +489,7 @@ fn fit_rtw(
 /// quality measure leaves them out too), and a surface turned away from the light
 /// close to the eye would otherwise claim the densest rows and columns of the warp
 /// (twice the uniform fit's error in a room seen along the light).
-fn front_lit(samples: &[EyeSample], light: LightDirection) -> Vec<EyeSample> {
+pub(crate) fn front_lit(samples: &[EyeSample], light: LightDirection) -> Vec<EyeSample> {
     samples
         .iter()
         .filter(|s| {

@@ -85,7 +85,7 @@
 //! | `SpotRtw` | spot | 1 | **S** | Rosen's RTW over the spot fit (a perspective base) |
 //! | `PointRtw` | point | 1 or 2 | **S**, D | Rosen's RTW over each side of the IPSM paraboloid |
 //! | `CubeRtw` | point | 1..=6 | **S**, **P**, D | Rosen's RTW over each focused cube face, from the oracle's per-axis needs of the samples (true normals where lit from the front), each face narrowed to its samples and sized per axis by the error its warp leaves |
-//! | `TiledCube` | point | one per tile | **S**, **P**, D | Arvo, *Tiled shadow maps*, over the focused cube faces: each face narrowed to its samples and cut into `TileOptions::grid`² cells, each cell as many texels as the 95th percentile of its samples' needs (true normals where lit from the front), uniform neighbours merged into one tile (a quadtree), all tiles in one atlas; the samples' layer is their tile |
+//! | `TiledCube` | point | one per tile | **S**, **P**, D | Arvo, *Tiled shadow maps*, over the focused cube faces: each face narrowed to its samples and cut into `TileOptions::grid`² cells, each cell as many texels as its front-lit samples need, but for the 5% of them that cost the most texels (given up greedily, kept at half the common need at least), uniform neighbours merged into one tile (a quadtree), all tiles in one atlas; the samples' layer is their tile |
 //!
 //! Cascade count: for each count `k` up to [`CascadePlan::max_cascades`] (preferring
 //! power-of-two sides), practical splits of the depth bounds are fitted tight to

@@ -290,11 +290,11 @@
 //!
 //! | configuration | DPSM | IPSM exact | cube, by need | cube, equal full faces | RTW over the faces | tiled |
 //! |---|---|---|---|---|---|---|
-//! | `point_near` | 4.73 | 2.62 | 1.90 (5 faces) | 2.46 | 1.19 | 0.83 |
-//! | `point_mid` | 28.9 | 13.2 | 7.48 (5 faces) | 18.6 | 1.69 | 2.15 |
-//! | `point_far` | 115 | 55.7 | 27.2 (5 faces) | 97.2 | 2.68 | 3.75 |
-//! | `point_inside` | 5.02 | 4.56 | 5.04 (6 faces) | 5.42 | 1.06 | 1.68 |
-//! | `facing_point` | 18.4 | 15.5 | 11.9 (6 faces) | 23.7 | 1.91 | 2.09 |
+//! | `point_near` | 4.73 | 2.62 | 1.90 (5 faces) | 2.46 | 1.19 | 0.79 |
+//! | `point_mid` | 28.9 | 13.2 | 7.48 (5 faces) | 18.6 | 1.69 | 1.93 |
+//! | `point_far` | 115 | 55.7 | 27.2 (5 faces) | 97.2 | 2.68 | 3.41 |
+//! | `point_inside` | 5.02 | 4.56 | 5.04 (6 faces) | 5.42 | 1.06 | 1.49 |
+//! | `facing_point` | 18.4 | 15.5 | 11.9 (6 faces) | 23.7 | 1.91 | 2.05 |
 //!
 //! With the light among the visible receivers every face is kept, and six equal maps
 //! of `1024² / 6` texels lose to a DPSM's two of `1024² / 2` (1.08 and 1.29 times its
@@ -312,7 +312,8 @@
 //! current engines' virtual shadow maps choose each page's resolution the same way)
 //! cuts each kept face into `grid x grid` cells ([`TileOptions`]), gives each cell
 //! as many texels per unit of `uv` as the caller says it needs (the umbrella's
-//! `TiledCube` technique: the 95th percentile of its eye samples' needs), groups
+//! `TiledCube` technique: its eye samples' needs, but for the 5% of all samples
+//! that would cost the most texels), groups
 //! four neighbours into one tile where that costs no more texels (a quadtree: a
 //! uniform region pays one guard border, not one per cell) and packs the tiles into
 //! one nearly square atlas whose square fits the budget. Each tile renders its
@@ -320,7 +321,7 @@
 //! square ([`TiledCube::tile_viewport`]); a point maps through its face, its cell
 //! ([`TiledCube::table`]) and its tile, the tile being the sample's layer
 //! ([`TiledCube::atlas_sample`] gives the atlas coordinates). Where the light is near
-//! the eye (`point_near` above) the tiles need 0.44 times the focused cube's error;
+//! the eye (`point_near` above) the tiles need 0.42 times the focused cube's error;
 //! where the need varies smoothly along rows and columns (a light far down the
 //! street), RTW's warp of the whole face does better.
 //!

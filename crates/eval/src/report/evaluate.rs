@@ -328,8 +328,8 @@ fn measure(
     let (phase_jitter, flip_rate) = temporal(&path, &technique, &map, &mut state);
     Ok(Measured {
         metrics: RowMetrics {
-            layers: technique.layers(),
-            layer_side: technique.layer_sizes().first().map_or(0, |s| s.0),
+            layers: texture_layers(&technique),
+            layer_side: texture_side(&technique),
             texels: technique.texels(),
             aliasing,
             misclassification: miss,
@@ -339,6 +339,22 @@ fn measure(
         m: pixels.m,
         lit: mask.lit,
     })
+}
+
+/// Layers of the technique's texture: a tiled cube map's tiles share one atlas.
+fn texture_layers(technique: &Technique) -> u32 {
+    match technique.shadow().tiled_cube() {
+        Some(_) => 1,
+        None => technique.layers(),
+    }
+}
+
+/// Side of the technique's (first) layer: a tiled cube map's atlas square.
+fn texture_side(technique: &Technique) -> u32 {
+    match technique.shadow().tiled_cube() {
+        Some(_) => technique.shadow().layer_side(),
+        None => technique.layer_sizes().first().map_or(0, |s| s.0),
+    }
 }
 
 /// What [`temporal`] refits along a camera path.
