@@ -333,15 +333,43 @@ pub(crate) fn texture_2d(
     })
 }
 
+/// A [`GpuContext`] for one test, held under a process-wide lock: the GPU tests of
+/// one test binary run one at a time (Mesa's llvmpipe has crashed with devices
+/// created and dropped on parallel test threads). Dereferences to the context.
+#[derive(Debug)]
+pub struct TestContext {
+    // Dropped first: the device goes while the lock is held.
+    ctx: GpuContext,
+    _serial: std::sync::MutexGuard<'static, ()>,
+}
+
+impl core::ops::Deref for TestContext {
+    type Target = GpuContext;
+    fn deref(&self) -> &GpuContext {
+        &self.ctx
+    }
+}
+
+/// Held by every [`TestContext`].
+static GPU_TESTS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// The context for a GPU test: `Some` when an adapter opens; `None` with a one-line
 /// notice on stderr when none does; a panic (test failure) when none does and
-/// `SHADOWMAP_REQUIRE_GPU=1` is set, so CI cannot silently skip.
+/// `SHADOWMAP_REQUIRE_GPU=1` is set, so CI cannot silently skip. The tests of one
+/// process that hold a context run one at a time ([`TestContext`]).
 ///
 /// # Panics
 /// When no adapter opens and `SHADOWMAP_REQUIRE_GPU=1`.
-pub fn test_context(test: &str) -> Option<GpuContext> {
+pub fn test_context(test: &str) -> Option<TestContext> {
+    // A test that failed while holding the lock poisons it; the next one may run.
+    let serial = GPU_TESTS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     match GpuContext::new_headless() {
-        Ok(ctx) => Some(ctx),
+        Ok(ctx) => Some(TestContext {
+            ctx,
+            _serial: serial,
+        }),
         Err(e) => {
             let required = std::env::var(REQUIRE_GPU_ENV).is_ok_and(|v| v == "1");
             assert!(!required, "{test}: {REQUIRE_GPU_ENV}=1 but {e}");
