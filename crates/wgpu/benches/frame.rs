@@ -463,8 +463,8 @@ fn ipsm_frame_cpu(c: &mut Criterion) {
 /// indirectly, uploads flushed; and the fit before it (`cube_rtw_fit`: the oracle's
 /// needs of a 480x270 ground G-buffer, one pair of 256-cell tables per face), with
 /// the cube maps sized by the same samples' needs beside it (`cube_fit_by_need`),
-/// and tiled cube maps' fit and depth-pass blocks (`cube_tiled_fit`,
-/// `cube_tiled_uniforms`).
+/// and tiled cube maps' fit, depth-pass blocks and caster bins (`cube_tiled_fit`,
+/// `cube_tiled_uniforms`, `cube_tiled_bins`).
 fn cube_rtw_frame_cpu(c: &mut Criterion) {
     let cam = camera();
     let lamp = Light::Point {
@@ -510,6 +510,10 @@ fn cube_rtw_frame_cpu(c: &mut Criterion) {
     {
         c.bench_function("cube_tiled_uniforms/city_block_lamp_2048", |b| {
             b.iter(|| black_box(shadowmap_wgpu::tiles::tiled_uniforms(black_box(t), 2048)));
+        });
+        let casters = city_casters();
+        c.bench_function("cube_tiled_bins/city_block_lamp_2048", |b| {
+            b.iter(|| black_box(shadowmap_wgpu::tiles::tile_bins(black_box(t), &casters)));
         });
     }
     let shadow = fit(&technique, &input).expect("cube_rtw");

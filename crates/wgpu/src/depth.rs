@@ -38,6 +38,8 @@
 use std::num::NonZeroU64;
 
 use crate::uniforms::{MatrixShadowRaw, ParaboloidLayerRaw, RtwShadowRaw};
+
+mod atlas;
 use crate::{BackendError, GpuContext, compose, shaders};
 
 /// The caster subdivision of RTW's depth pass lives beside the warp tables in
@@ -258,6 +260,8 @@ pub struct ShadowDepthPass {
     texture: wgpu::Texture,
     array_view: wgpu::TextureView,
     layer_views: Vec<wgpu::TextureView>,
+    /// The tiles' caster indices of an atlas pass ([`ShadowDepthPass::encode_tiles`]).
+    tile_indices: Option<wgpu::Buffer>,
 }
 
 /// Bytes reserved per layer in the uniform buffer (before alignment).
@@ -372,6 +376,7 @@ impl ShadowDepthPass {
             texture,
             array_view,
             layer_views,
+            tile_indices: None,
         })
     }
 
@@ -450,68 +455,6 @@ impl ShadowDepthPass {
         }
         self.upload(ctx, encoder, uniforms)?;
         self.record_refined(encoder, refined);
-        Ok(())
-    }
-
-    /// Draws the tiles of an atlas (a tiled cube map,
-    /// [`crate::tiles::tiled_uniforms`]) into layer 0 of a one-layer matrix pass:
-    /// one render pass, cleared once, each tile through its own block into its
-    /// square (viewport and scissor). The uniform buffer grows to one block per tile.
-    ///
-    /// # Errors
-    /// [`BackendError::InvalidInput`] for a pass that is not a one-layer matrix pass,
-    /// no tiles, or a tile past the texture.
-    pub fn encode_tiles(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        mesh: &MeshBuffers,
-        draws: &[crate::tiles::TileDraw],
-    ) -> Result<(), BackendError> {
-        if self.desc.technique != DepthTechnique::Matrix || self.desc.layers != 1 {
-            return Err(BackendError::InvalidInput(
-                "tiles are drawn by a one-layer matrix pass",
-            ));
-        }
-        let side = self.desc.resolution;
-        let inside = |d: &crate::tiles::TileDraw| {
-            d.side > 0
-                && d.offset
-                    .iter()
-                    .all(|&o| o.checked_add(d.side).is_some_and(|e| e <= side))
-        };
-        if draws.is_empty() || !draws.iter().all(inside) {
-            return Err(BackendError::InvalidInput(
-                "a tile outside the depth texture",
-            ));
-        }
-        let bytes = self.slot * draws.len() as u64;
-        if self.uniforms.size() < bytes {
-            self.uniforms = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("shadowmap depth uniforms"),
-                size: bytes,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            self.bind_group =
-                make_bind_group(&ctx.device, &self.layout, &self.uniforms, self.block, None);
-        }
-        let mut blocks = vec![0u8; bytes as usize];
-        for (chunk, d) in blocks.chunks_mut(self.slot as usize).zip(draws) {
-            let raw = bytemuck::bytes_of(&d.block);
-            chunk[..raw.len()].copy_from_slice(raw);
-        }
-        ctx.queue.write_buffer(&self.uniforms, 0, &blocks);
-        let mut pass = self.begin_layer(encoder, 0);
-        pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-        pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-        for (i, d) in draws.iter().enumerate() {
-            let [x, y] = d.offset;
-            pass.set_viewport(x as f32, y as f32, d.side as f32, d.side as f32, 0.0, 1.0);
-            pass.set_scissor_rect(x, y, d.side, d.side);
-            pass.set_bind_group(0, &self.bind_group, &[(self.slot * i as u64) as u32]);
-            pass.draw_indexed(0..mesh.index_count, 0, 0..1);
-        }
         Ok(())
     }
 

@@ -364,10 +364,13 @@ fn warped_cube_faces_match_the_cpu_reference() {
 }
 
 /// Tiled cube maps (`cube_tiled`): every tile drawn through its cropped face
-/// projection into its square of the atlas (one matrix pass, a viewport per tile)
-/// matches eval's reference, which rasterizes each tile on its own at its stored
-/// side, within the tolerance of the other depth tests; texels between the tiles
-/// stay clear.
+/// projection into its square of the atlas (one matrix pass, a viewport per tile),
+/// with the whole mesh and with only the casters binned to the tile, matches eval's
+/// reference, which rasterizes each tile on its own at its stored side, within the
+/// tolerance of the other depth tests; texels between the tiles stay clear; the bins
+/// draw under a quarter of the triangles the unbinned pass draws (on this city
+/// block, 5.5 times fewer: the ground's and the walls' large triangles reach many
+/// tiles).
 #[test]
 fn tiled_cube_atlas_matches_the_cpu_reference() {
     let Some(ctx) =
@@ -383,20 +386,43 @@ fn tiled_cube_atlas_matches_the_cpu_reference() {
         .unwrap();
     let side = technique.shadow().layer_side();
     let uniforms = shadowmap_wgpu::tiles::tiled_uniforms(tiled, side);
-    let gpu = ctx
-        .scoped(|ctx| {
-            let mesh = MeshBuffers::from_triangles(ctx, &tris)?;
-            let desc = DepthPassDesc::new(DepthTechnique::Matrix, side);
-            let mut pass = ShadowDepthPass::new(ctx, &desc)?;
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            pass.encode_tiles(ctx, &mut encoder, &mesh, &uniforms.draws)?;
-            ctx.queue.submit([encoder.finish()]);
-            pass.readback_depth(ctx)
-        })
-        .expect("GPU depth pass");
+    let bins = shadowmap_wgpu::tiles::tile_bins(tiled, &tris);
+    let drawn = bins.indices.len() / 3;
+    eprintln!(
+        "{drawn} triangles drawn over {} tiles ({} per tile of {})",
+        tiled.tiles.len(),
+        drawn / tiled.tiles.len(),
+        tris.len()
+    );
+    assert!(drawn < tris.len() * tiled.tiles.len() / 4, "{drawn}");
+    for bins in [None, Some(&bins)] {
+        let gpu = ctx
+            .scoped(|ctx| {
+                let mesh = MeshBuffers::from_triangles(ctx, &tris)?;
+                let desc = DepthPassDesc::new(DepthTechnique::Matrix, side);
+                let mut pass = ShadowDepthPass::new(ctx, &desc)?;
+                let mut encoder = ctx.device.create_command_encoder(&Default::default());
+                pass.encode_tiles(ctx, &mut encoder, &mesh, &uniforms.draws, bins)?;
+                ctx.queue.submit([encoder.finish()]);
+                pass.readback_depth(ctx)
+            })
+            .expect("GPU depth pass");
+        compare_atlas(&gpu, &cpu, &uniforms.draws, side);
+    }
+}
+
+/// Every tile's square of the GPU atlas (`side` texels a row) against the CPU
+/// reference's layer of the tile: at most 0.1% of texels more than 1e-4 apart, and
+/// nothing drawn outside the tiles.
+fn compare_atlas(
+    gpu: &[f32],
+    cpu: &DepthMap,
+    draws: &[shadowmap_wgpu::tiles::TileDraw],
+    side: u32,
+) {
     let (mut differing, mut compared, mut offset) = (0, 0, 0);
     let mut covered = vec![false; gpu.len()];
-    for (layer, draw) in uniforms.draws.iter().enumerate() {
+    for (layer, draw) in draws.iter().enumerate() {
         let s = draw.side as usize;
         assert_eq!(cpu.layer_size(layer as u32), (draw.side, draw.side));
         for row in 0..s {
@@ -413,9 +439,8 @@ fn tiled_cube_atlas_matches_the_cpu_reference() {
     }
     let fraction = differing as f64 / compared as f64;
     eprintln!(
-        "cube_tiled ({} tiles, atlas {:?} in {side}): {differing} of {compared} texels differ ({fraction:.5})",
-        uniforms.draws.len(),
-        tiled.atlas
+        "cube_tiled ({} tiles in {side}): {differing} of {compared} texels differ ({fraction:.5})",
+        draws.len()
     );
     assert!(fraction <= 1e-3, "{differing} of {compared} texels differ");
     let stray = gpu

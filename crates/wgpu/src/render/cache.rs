@@ -66,6 +66,17 @@ impl DepthCache {
             .ok_or(BackendError::InvalidInput("no scene uploaded"))
     }
 
+    /// The scene's caster triangles of [`DepthCache::use_scene`].
+    ///
+    /// # Errors
+    /// [`BackendError::InvalidInput`] before any scene.
+    pub(super) fn triangles(&self) -> Result<&[[Vec3; 3]], BackendError> {
+        self.casters
+            .as_ref()
+            .map(|c| c.triangles.as_slice())
+            .ok_or(BackendError::InvalidInput("no scene uploaded"))
+    }
+
     /// The index of the depth pass of `desc`, created (and the least recently used
     /// one dropped) when it is not kept.
     ///

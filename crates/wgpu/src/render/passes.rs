@@ -13,7 +13,7 @@ use crate::depth::{
 };
 use crate::profile::GpuProfiler;
 use crate::refine::RefineOptions;
-use crate::tiles::tiled_uniforms;
+use crate::tiles::{tile_bins, tiled_uniforms};
 use crate::uniforms::{
     FrameRaw, RtwShadowRaw, ToRaw, paraboloid_layers, warped_cube, warped_paraboloid,
 };
@@ -76,10 +76,11 @@ impl DepthJob<'_> {
         }
         if let ShadowTechnique::TiledCube(tiled) = technique {
             let uniforms = tiled_uniforms(tiled, self.options.shadow_resolution);
+            let bins = tile_bins(tiled, cache.triangles()?);
             let index = cache.pass_index(ctx, &self.desc(DepthTechnique::Matrix, 1))?;
             let (pass, mesh, _) = cache.parts(ctx, index, None)?;
             timed(profiler, encoder, "depth", |e| {
-                pass.encode_tiles(ctx, e, mesh, &uniforms.draws)
+                pass.encode_tiles(ctx, e, mesh, &uniforms.draws, Some(&bins))
             })?;
             return Ok(DepthOutput {
                 pass: index,
