@@ -333,7 +333,7 @@ fn json(adapter: &str, profiler: &GpuProfiler, rows: &[Row]) -> String {
 }
 
 /// Every technique of the umbrella crate, plus RTW over the spot fit, over the cube
-/// faces and over the IPSM paraboloid.
+/// faces and over the IPSM paraboloid, and the tiled cube maps.
 fn techniques() -> Vec<Technique> {
     let mut all = Technique::all_default().to_vec();
     all.push(Technique::SpotRtw(RtwPlan::default()));
@@ -344,6 +344,10 @@ fn techniques() -> Vec<Technique> {
     all.push(Technique::PointRtw {
         ipsm: Default::default(),
         rtw: RtwPlan::default(),
+    });
+    all.push(Technique::TiledCube {
+        cube: Default::default(),
+        tiles: Default::default(),
     });
     all
 }
