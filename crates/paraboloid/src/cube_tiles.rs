@@ -130,9 +130,9 @@ pub struct TiledCube {
     /// The tile of every cell, face by face (layer order), rows top to bottom,
     /// columns left to right: entry `(layer * grid + row) * grid + col`.
     pub table: Vec<u32>,
-    /// Width and height of the atlas in texels, nearly square; a renderer stores it
-    /// in a square texture of its larger side, whose area is what the map costs
-    /// ([`TiledCube::texels`]).
+    /// Width and height of the atlas in texels; its area is what the map costs
+    /// ([`TiledCube::texels`]). A renderer that stores it in a square texture of
+    /// its larger side (as `shadowmap-wgpu` does) allocates more.
     pub atlas: [u32; 2],
 }
 
@@ -146,13 +146,15 @@ impl TiledCube {
     /// Four neighbouring tiles of one face (a quadtree's children) become one
     /// tile, at the largest of their densities, where that costs no more texels at
     /// the scale the separate cells would get: uniform regions pay one border, not
-    /// one per cell. Where one smallest tile per cell would take more than half the
-    /// budget, the grid is halved until it does not (documented fallback; a coarser
-    /// cell needs the most of the cells it covers).
+    /// one per cell. Of the grids from `options.grid` down to one cell per face
+    /// (halving; a coarser cell needs the most of the cells it covers), the one whose
+    /// tiles get the most texels per unit of need is kept: with a small budget the
+    /// borders of many small tiles cost more than coarser cells waste. A grid whose
+    /// smallest tiles would take more than half the budget is not tried.
     ///
     /// # Errors
     /// [`ParaboloidError::InvalidOptions`] for invalid `options` or a budget below
-    /// twice the smallest tile of each face.
+    /// twice one smallest tile per face.
     pub fn new(
         cube: CubeMap,
         options: &TileOptions,
@@ -163,67 +165,28 @@ impl TiledCube {
         let faces = cube.faces.len();
         let border = options.border;
         let smallest = |g: u32| faces as u64 * u64::from(g * g) * u64::from(1 + 2 * border).pow(2);
+        let mut best: Option<Built> = None;
         let mut grid = options.grid;
-        while grid > 1 && 2 * smallest(grid) > budget {
-            grid /= 2;
-        }
-        if faces == 0 || 2 * smallest(grid) > budget {
-            return Err(ParaboloidError::InvalidOptions);
-        }
-        let cells = coarse_densities(densities, faces, options.grid, grid);
-        // The scale every cell on its own would get decides the merges.
-        let unit = |d: f64, span: u32| d * f64::from(span) / f64::from(grid);
-        let alone: Vec<f64> = cells.iter().map(|d| unit(*d, 1)).collect();
-        let scale = Layout::fit(&alone, border, budget).scale;
-        let mut tiles = Vec::new();
-        for layer in 0..faces as u32 {
-            let first = layer as usize * (grid * grid) as usize;
-            let face = &cells[first..first + (grid * grid) as usize];
-            merge_face(
-                face,
-                grid,
-                |t| {
-                    let cost = |d: f64, span: u32| {
-                        let side =
-                            math::ceil(scale * unit(d, span)).max(1.0) + f64::from(2 * border);
-                        side * side
-                    };
-                    t.cost = cost(t.density, t.span);
-                    t.merged_cost = cost(t.density, 2 * t.span);
-                },
-                &mut |cell, span, density| {
-                    tiles.push((layer, cell, span, density));
-                },
-            );
-        }
-        let wanted: Vec<f64> = tiles.iter().map(|t| unit(t.3, t.2)).collect();
-        let layout = Layout::fit(&wanted, border, budget);
-        let tiles: Vec<CubeTile> = tiles
-            .iter()
-            .zip(&layout.placed)
-            .map(|(&(layer, cell, span, _), &(side, offset))| CubeTile {
-                layer,
-                cell,
-                span,
-                side,
-                offset,
-            })
-            .collect();
-        let mut table = alloc::vec![0u32; faces * (grid * grid) as usize];
-        for (i, t) in tiles.iter().enumerate() {
-            for row in t.cell[1]..t.cell[1] + t.span {
-                for col in t.cell[0]..t.cell[0] + t.span {
-                    table[((t.layer * grid + row) * grid + col) as usize] = i as u32;
+        loop {
+            if faces > 0 && 2 * smallest(grid) <= budget {
+                let built = Built::new(densities, faces, options, grid, budget);
+                if best.as_ref().is_none_or(|b| built.scale > b.scale) {
+                    best = Some(built);
                 }
             }
+            if grid <= 1 {
+                break;
+            }
+            grid /= 2;
         }
+        let built = best.ok_or(ParaboloidError::InvalidOptions)?;
         Ok(Self {
             cube,
-            grid,
+            grid: built.grid,
             border,
-            tiles,
-            table,
-            atlas: layout.atlas,
+            tiles: built.tiles,
+            table: built.table,
+            atlas: built.atlas,
         })
     }
 
@@ -243,12 +206,10 @@ impl TiledCube {
             .unwrap_or(0)
     }
 
-    /// Texels of the square texture holding the atlas (its larger side squared):
-    /// what the map costs, gaps included.
+    /// Texels of the atlas: what the map costs, gaps between the tiles included.
     #[must_use]
     pub fn texels(&self) -> u64 {
-        let side = u64::from(self.atlas[0].max(self.atlas[1]));
-        side * side
+        area(self.atlas)
     }
 
     /// The index of the tile holding face `uv` of `layer` (clamped to the face's
@@ -365,6 +326,75 @@ impl ShadowMapping for TiledCube {
     }
 }
 
+/// The tiles of one grid, merged and packed.
+struct Built {
+    grid: u32,
+    /// Interior texels per side per unit of a tile's wanted side: the texels per
+    /// unit of need every tile gets.
+    scale: f64,
+    tiles: Vec<CubeTile>,
+    table: Vec<u32>,
+    atlas: [u32; 2],
+}
+
+impl Built {
+    /// The cells of `grid x grid` per face (densities given for `options.grid`),
+    /// merged where that saves texels, packed into the budget.
+    fn new(densities: &[f64], faces: usize, options: &TileOptions, grid: u32, budget: u64) -> Self {
+        let border = options.border;
+        let cells = coarse_densities(densities, faces, options.grid, grid);
+        // The scale every cell on its own would get decides the merges.
+        let unit = |d: f64, span: u32| d * f64::from(span) / f64::from(grid);
+        let alone: Vec<f64> = cells.iter().map(|d| unit(*d, 1)).collect();
+        let scale = Layout::fit(&alone, border, budget).scale;
+        let price = |t: &mut Node| {
+            let side = math::ceil(scale * unit(t.density, t.span)).max(1.0) + f64::from(2 * border);
+            t.cost = side * side;
+        };
+        let mut found = Vec::new();
+        let per_face = (grid * grid) as usize;
+        for layer in 0..faces as u32 {
+            let first = layer as usize * per_face;
+            merge_face(
+                &cells[first..first + per_face],
+                grid,
+                price,
+                &mut |cell, span, density| {
+                    found.push((layer, cell, span, density));
+                },
+            );
+        }
+        let wanted: Vec<f64> = found.iter().map(|t| unit(t.3, t.2)).collect();
+        let layout = Layout::fit(&wanted, border, budget);
+        let tiles: Vec<CubeTile> = found
+            .iter()
+            .zip(&layout.placed)
+            .map(|(&(layer, cell, span, _), &(side, offset))| CubeTile {
+                layer,
+                cell,
+                span,
+                side,
+                offset,
+            })
+            .collect();
+        let mut table = alloc::vec![0u32; faces * per_face];
+        for (i, t) in tiles.iter().enumerate() {
+            for row in t.cell[1]..t.cell[1] + t.span {
+                for col in t.cell[0]..t.cell[0] + t.span {
+                    table[((t.layer * grid + row) * grid + col) as usize] = i as u32;
+                }
+            }
+        }
+        Self {
+            grid,
+            scale: layout.scale,
+            tiles,
+            table,
+            atlas: layout.atlas,
+        }
+    }
+}
+
 /// The densities of `faces` faces of `grid x grid` cells from those of `given x
 /// given` cells (`given` a multiple of `grid`): each cell the largest valid density
 /// of the cells it covers, 0 without one.
@@ -409,6 +439,11 @@ fn shelves(placed: &mut [(u32, [u32; 2])], order: &[usize], border: u32, width: 
     y + shelf
 }
 
+/// Texels of an atlas.
+fn area(atlas: [u32; 2]) -> u64 {
+    u64::from(atlas[0]) * u64::from(atlas[1])
+}
+
 /// A tile of the quadtree while [`merge_face`] builds it.
 #[derive(Clone, Copy, Debug, Default)]
 struct Node {
@@ -416,8 +451,6 @@ struct Node {
     span: u32,
     /// Texels of the tile as it is, border included.
     cost: f64,
-    /// Texels of the tile were it twice as wide (its parent's size at its density).
-    merged_cost: f64,
 }
 
 /// Groups the cells of one face (`grid x grid` densities) bottom-up into square
@@ -509,11 +542,7 @@ impl Layout {
         let mut order: Vec<usize> = (0..wanted.len()).collect();
         order.sort_by(|a, b| wanted[*b].total_cmp(&wanted[*a]).then(a.cmp(b)));
         let at = |k: f64| Self::pack(wanted, &order, k, border);
-        // The square texture that holds the atlas is what a renderer allocates.
-        let fits = |l: &Self| {
-            let side = u64::from(l.atlas[0].max(l.atlas[1]));
-            side > 0 && side * side <= budget
-        };
+        let fits = |l: &Self| l.atlas[0] > 0 && area(l.atlas) <= budget;
         let total: f64 = wanted.iter().map(|d| d * d).sum();
         let mut hi = if total > 0.0 {
             math::sqrt(budget as f64 / total) + 1.0
@@ -537,9 +566,9 @@ impl Layout {
     }
 
     /// Shelf packing of the tiles at scale `k` in `order` (highest first): of the
-    /// shelf widths from the side of a square of the tiles' area up to 30% wider,
-    /// the one whose atlas has the smallest larger side (the square texture a
-    /// renderer allocates for it). `atlas` is `[0, 0]` past the largest texture side.
+    /// shelf widths from the side of a square of the tiles' area up to twice it, the
+    /// one whose atlas is smallest (then the squarest). `atlas` is `[0, 0]` past the
+    /// largest texture side.
     fn pack(wanted: &[f64], order: &[usize], k: f64, border: u32) -> Self {
         let side = |d: f64| -> u32 {
             let s = math::ceil(k * d);
@@ -554,11 +583,11 @@ impl Layout {
         let total: u64 = placed.iter().map(|p| stored(p.0) * stored(p.0)).sum();
         let widest = placed.iter().map(|p| stored(p.0)).max().unwrap_or(1);
         let square = (math::ceil(math::sqrt(total as f64)) as u64).max(widest);
-        let width = (0..=15)
-            .map(|step| square + square * step / 50)
+        let width = (0..=10)
+            .map(|step| square + square * step / 10)
             .min_by_key(|&w| {
                 let height = shelves(&mut placed, order, border, w);
-                (w.max(height), w)
+                (w * height, w.max(height), w)
             })
             .unwrap_or(square);
         let height = shelves(&mut placed, order, border, width);

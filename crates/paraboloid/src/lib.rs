@@ -291,10 +291,10 @@
 //! | configuration | DPSM | IPSM exact | cube, by need | cube, equal full faces | RTW over the faces | tiled |
 //! |---|---|---|---|---|---|---|
 //! | `point_near` | 4.73 | 2.62 | 1.90 (5 faces) | 2.46 | 1.19 | 0.79 |
-//! | `point_mid` | 28.9 | 13.2 | 7.48 (5 faces) | 18.6 | 1.69 | 1.93 |
-//! | `point_far` | 115 | 55.7 | 27.2 (5 faces) | 97.2 | 2.68 | 3.41 |
-//! | `point_inside` | 5.02 | 4.56 | 5.04 (6 faces) | 5.42 | 1.06 | 1.49 |
-//! | `facing_point` | 18.4 | 15.5 | 11.9 (6 faces) | 23.7 | 1.91 | 2.05 |
+//! | `point_mid` | 28.9 | 13.2 | 7.48 (5 faces) | 18.6 | 1.69 | 1.90 |
+//! | `point_far` | 115 | 55.7 | 27.2 (5 faces) | 97.2 | 2.68 | 3.40 |
+//! | `point_inside` | 5.02 | 4.56 | 5.04 (6 faces) | 5.42 | 1.06 | 1.47 |
+//! | `facing_point` | 18.4 | 15.5 | 11.9 (6 faces) | 23.7 | 1.91 | 1.97 |
 //!
 //! With the light among the visible receivers every face is kept, and six equal maps
 //! of `1024² / 6` texels lose to a DPSM's two of `1024² / 2` (1.08 and 1.29 times its
@@ -315,8 +315,9 @@
 //! `TiledCube` technique: its eye samples' needs, but for the 5% of all samples
 //! that would cost the most texels), groups
 //! four neighbours into one tile where that costs no more texels (a quadtree: a
-//! uniform region pays one guard border, not one per cell) and packs the tiles into
-//! one nearly square atlas whose square fits the budget. Each tile renders its
+//! uniform region pays one guard border, not one per cell), keeps the grid (halving
+//! from the one asked) whose tiles get the most texels, and packs the tiles into one
+//! atlas of the budget. Each tile renders its
 //! face's projection cropped to it ([`TiledCube::tile_clip_from_world`]) into its
 //! square ([`TiledCube::tile_viewport`]); a point maps through its face, its cell
 //! ([`TiledCube::table`]) and its tile, the tile being the sample's layer

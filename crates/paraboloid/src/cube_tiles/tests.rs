@@ -172,8 +172,8 @@ fn tile_clip_agrees_with_the_lookup() {
     }
 }
 
-/// A budget too small for the grid halves it; below one small tile per face it is
-/// an error, as are a grid that is not a power of two and a border past the limit.
+/// A budget too small for the grid takes a coarser one; below one small tile per
+/// face it is an error, as are a grid that is not a power of two and a border past the limit.
 #[test]
 fn small_budgets_coarsen_the_grid_and_bad_options_are_errors() {
     let cube = street_cube(false);
@@ -182,7 +182,7 @@ fn small_budgets_coarsen_the_grid_and_bad_options_are_errors() {
     let options = TileOptions::default();
     // 16x16 cells of at least 5x5 texels need 5 * 256 * 25 per copy.
     let t = TiledCube::new(cube.clone(), &options, &d, faces * 256 * 25).unwrap();
-    assert_eq!(t.grid, 8);
+    assert!(t.grid <= 8, "{}", t.grid);
     check_layout(&t, faces * 256 * 25);
     assert!(matches!(
         TiledCube::new(cube.clone(), &options, &d, faces * 25),
