@@ -556,13 +556,15 @@ mod serde_impls {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use glam::Vec4;
     use shadowmap_frustum::Projection;
 
     use super::*;
 
-    fn street() -> (Camera, Light, SceneBounds) {
+    /// A street under a lamp ahead of the eye (five faces kept); shared with the
+    /// tiled cube map's tests.
+    pub(crate) fn street() -> (Camera, Light, SceneBounds) {
         let camera = Camera::look_to(
             Vec3::new(0.0, 2.0, 0.0),
             Vec3::new(0.0, -0.2, -1.0),

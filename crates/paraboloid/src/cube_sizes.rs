@@ -195,20 +195,38 @@ fn pack_width(sizes: &[Size], width: u32) -> (ArrayVec<[u32; 2], 6>, Option<[u32
         sb[1].cmp(&sa[1]).then(sb[0].cmp(&sa[0])).then(a.cmp(b))
     });
     let mut offsets: ArrayVec<[u32; 2], 6> = (0..order.len()).map(|_| [0, 0]).collect();
+    let height = shelves(
+        &order,
+        |i| sizes[i].map(u64::from),
+        u64::from(width),
+        |i, at| offsets[i] = at,
+    );
+    let atlas = (height <= u64::from(MAX_SIDE)).then_some([width, height as u32]);
+    (offsets, atlas)
+}
+
+/// Shelf packing, the one the cube's faces and the tiled cube's tiles share: the
+/// rectangles in `order` (highest first) left to right on shelves `width` texels
+/// wide, a new shelf when the next does not fit, each shelf as high as its first;
+/// `place(index, top-left corner)` for each. Returns the shelves' height.
+pub(crate) fn shelves(
+    order: &[usize],
+    size: impl Fn(usize) -> [u64; 2],
+    width: u64,
+    mut place: impl FnMut(usize, [u32; 2]),
+) -> u64 {
     let (mut x, mut y, mut shelf) = (0u64, 0u64, 0u64);
-    for &i in &order {
-        let [w, h] = sizes[i].map(u64::from);
-        if x + w > u64::from(width) {
+    for &i in order {
+        let [w, h] = size(i);
+        if x + w > width {
             y += shelf;
             (x, shelf) = (0, 0);
         }
-        offsets[i] = [x as u32, y.min(u64::from(u32::MAX)) as u32];
+        place(i, [x as u32, y.min(u64::from(u32::MAX)) as u32]);
         x += w;
         shelf = shelf.max(h);
     }
-    let height = y + shelf;
-    let atlas = (height <= u64::from(MAX_SIDE)).then_some([width, height as u32]);
-    (offsets, atlas)
+    y + shelf
 }
 
 impl CubeMap {

@@ -29,6 +29,7 @@ use shadowmap_frustum::{ShadowMapping, ShadowSample, math};
 
 use crate::ParaboloidError;
 use crate::cube::CubeMap;
+use crate::cube_sizes::{area, shelves};
 
 /// Largest tile grid per face side.
 pub const MAX_TILE_GRID: u32 = 64;
@@ -422,26 +423,15 @@ fn coarse_densities(densities: &[f64], faces: usize, given: u32, grid: u32) -> V
 }
 
 /// Places the tiles of `placed` (interior side, corner) in `order` on shelves of
-/// `width` texels, each shelf as high as its first (highest) tile; returns the
-/// height of the shelves.
-fn shelves(placed: &mut [(u32, [u32; 2])], order: &[usize], border: u32, width: u64) -> u64 {
-    let (mut x, mut y, mut shelf) = (0u64, 0u64, 0u64);
-    for &i in order {
-        let s = u64::from(placed[i].0 + 2 * border);
-        if x + s > width {
-            y += shelf;
-            (x, shelf) = (0, 0);
-        }
-        placed[i].1 = [x as u32, y.min(u64::from(u32::MAX)) as u32];
-        x += s;
-        shelf = shelf.max(s);
-    }
-    y + shelf
-}
-
-/// Texels of an atlas.
-fn area(atlas: [u32; 2]) -> u64 {
-    u64::from(atlas[0]) * u64::from(atlas[1])
+/// `width` texels ([`shelves`], borders included); returns the shelves' height.
+fn place_tiles(placed: &mut [(u32, [u32; 2])], order: &[usize], border: u32, width: u64) -> u64 {
+    let stored: Vec<u64> = placed.iter().map(|p| u64::from(p.0 + 2 * border)).collect();
+    shelves(
+        order,
+        |i| [stored[i], stored[i]],
+        width,
+        |i, at| placed[i].1 = at,
+    )
 }
 
 /// A tile of the quadtree while [`merge_face`] builds it.
@@ -586,11 +576,11 @@ impl Layout {
         let width = (0..=10)
             .map(|step| square + square * step / 10)
             .min_by_key(|&w| {
-                let height = shelves(&mut placed, order, border, w);
+                let height = place_tiles(&mut placed, order, border, w);
                 (w * height, w.max(height), w)
             })
             .unwrap_or(square);
-        let height = shelves(&mut placed, order, border, width);
+        let height = place_tiles(&mut placed, order, border, width);
         let max = u64::from(MAX_SIDE);
         let atlas = if width <= max && height <= max {
             [width as u32, height as u32]

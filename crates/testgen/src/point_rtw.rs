@@ -128,9 +128,6 @@ pub fn check_cube_samples(
         ));
     }
     let floor = near_floor(&case.cube, position, range);
-    let tol = 1e-4;
-    let inside =
-        |uv: DVec2| uv.cmpge(DVec2::splat(-tol)).all() && uv.cmple(DVec2::splat(1.0 + tol)).all();
     let mut checked = 0;
     for s in &case.samples {
         let p = s.position.as_dvec3();
@@ -156,7 +153,10 @@ pub fn check_cube_samples(
                 s.position
             ));
         };
-        if !(m.uv.is_finite() && inside(m.uv)) || m.layer != c.layer || m.depth != c.depth {
+        if !(m.uv.is_finite() && inside_unit_square(m.uv))
+            || m.layer != c.layer
+            || m.depth != c.depth
+        {
             return Err(format!(
                 "sample {}: cube {c:?}, technique {m:?}",
                 s.position
@@ -188,9 +188,6 @@ pub fn check_tiled_samples(
     }
     check_tiles_apart(tiled)?;
     check_table(tiled)?;
-    let tol = 1e-4;
-    let inside =
-        |uv: DVec2| uv.cmpge(DVec2::splat(-tol)).all() && uv.cmple(DVec2::splat(1.0 + tol)).all();
     let mut checked = 0;
     for s in &case.samples {
         let p = s.position.as_dvec3();
@@ -203,7 +200,10 @@ pub fn check_tiled_samples(
         let m = mapping
             .map_point(p)
             .ok_or_else(|| format!("sample {} stored by the cube, not by the tiles", s.position))?;
-        if m.layer as usize != index || !(m.uv.is_finite() && inside(m.uv)) || m.depth != c.depth {
+        if m.layer as usize != index
+            || !(m.uv.is_finite() && inside_unit_square(m.uv))
+            || m.depth != c.depth
+        {
             return Err(format!("sample {}: cube {c:?}, tiles {m:?}", s.position));
         }
         let a = tiled.atlas_sample(m).ok_or("no atlas sample")?;
@@ -212,7 +212,7 @@ pub fn check_tiled_samples(
         let texel = a.uv * atlas;
         let lo = DVec2::new(f64::from(offset[0]), f64::from(offset[1]));
         let hi = lo + f64::from(side);
-        if !(texel.cmpge(lo - tol).all() && texel.cmple(hi + tol).all()) {
+        if !(texel.cmpge(lo - UV_TOLERANCE).all() && texel.cmple(hi + UV_TOLERANCE).all()) {
             return Err(format!("texel {texel} outside its tile {lo}..{hi}"));
         }
         checked += 1;
@@ -241,6 +241,14 @@ fn check_table(tiled: &TiledCube) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Rounding allowed past a map's edge, in `uv` (and in atlas texels).
+const UV_TOLERANCE: f64 = 1e-4;
+
+/// `uv` inside `[0, 1]²` up to [`UV_TOLERANCE`].
+fn inside_unit_square(uv: DVec2) -> bool {
+    uv.cmpge(DVec2::splat(-UV_TOLERANCE)).all() && uv.cmple(DVec2::splat(1.0 + UV_TOLERANCE)).all()
 }
 
 /// The tiles' squares (border included) lie inside the atlas and overlap nowhere.

@@ -1,24 +1,11 @@
 use glam::{Vec3, Vec4};
-use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds};
 
 use super::*;
 use crate::CubeOptions;
 
-/// A street under a lamp ahead of the eye (five faces kept).
+/// The cube tests' street under a lamp (five faces kept).
 fn street_cube(reversed_z: bool) -> CubeMap {
-    let camera = Camera::look_to(
-        Vec3::new(0.0, 2.0, 0.0),
-        Vec3::new(0.0, -0.2, -1.0),
-        Vec3::Y,
-        Projection::perspective(1.0, 16.0 / 9.0, 0.5, 300.0),
-    )
-    .unwrap();
-    let light = Light::Point {
-        position: Vec3::new(5.0, 6.0, -30.0),
-        range: 200.0,
-    };
-    let ground = Aabb::new(Vec3::new(-150.0, 0.0, -320.0), Vec3::new(150.0, 1.0, 20.0));
-    let scene = SceneBounds::new(ground, Aabb::new(ground.min, ground.max + 30.0 * Vec3::Y));
+    let (camera, light, scene) = crate::cube::tests::street();
     let options = CubeOptions::default().with_reversed_z(reversed_z);
     CubeMap::fit(&light, &camera, None, &scene, &options).unwrap()
 }
