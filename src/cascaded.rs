@@ -13,19 +13,21 @@ use crate::fit::{FitError, FitInput, predictions};
 use crate::shadow::Fitted;
 use crate::technique::CascadePlan;
 
-/// Stable or tight cascades (PSSM over the depth bounds), their count chosen by
-/// [`choose_splits`] and kept in `state` with the stable maps' extents.
 /// How a cascaded fit gets its count.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum CountChoice {
     /// Predicted this frame ([`choose_splits`]).
     Predict,
-    /// The count in the state, predicted this frame by another fit of the same
-    /// prediction (`auto` fits the tight cascades, then the stable ones, whose count
-    /// is predicted by the same tight fits): the prediction is not run twice.
+    /// The count in the state, predicted this frame by another fit (`auto` fits
+    /// the tight cascades, then the stable ones with the count the tight ones just
+    /// predicted: one prediction less per frame, and `auto` measures every
+    /// candidate it fits anyway).
     Keep,
 }
 
+/// Stable or tight cascades (PSSM over the depth bounds), their count chosen by
+/// [`choose_splits`] on their own predicted error and kept in `state` with the
+/// stable maps' extents.
 pub(crate) fn fit_cascades(
     plan: &CascadePlan,
     stable: bool,
@@ -36,12 +38,21 @@ pub(crate) fn fit_cascades(
 ) -> Result<(Fitted, u32), FitError> {
     let camera = ValidCamera::new(input.camera)?;
     let mut count = state.count();
-    let tight = |splits: &CascadeSplits, k: u32| -> Option<Candidate> {
+    // Each count is predicted as it would be fitted: the stable cascades from a copy
+    // of the held maps, so the prediction leaves `state` as it found it.
+    let held = *state;
+    let candidate = |splits: &CascadeSplits, k: u32| -> Option<Candidate> {
         let options = cascade_options(input, k, direction).ok()?;
-        let set = CascadeSet::fit_valid(&camera, direction, splits, &options).ok()?;
+        let set = if stable {
+            let options = options.with_fit(CascadeFit::Stable);
+            let mut scratch = held;
+            CascadeSet::fit_with_state(&camera, direction, splits, &options, &mut scratch).ok()?
+        } else {
+            CascadeSet::fit_valid(&camera, direction, splits, &options).ok()?
+        };
         Some(Candidate::Cascades(set))
     };
-    let splits = choose_splits(plan, input, &camera, &mut count, &tight, choice)?;
+    let splits = choose_splits(plan, input, &camera, &mut count, &candidate, choice)?;
     state.set_count(count);
     let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
     let fit = cascade_options(input, layers, direction)?
@@ -205,8 +216,11 @@ impl ShadowMapping for Candidate {
 /// For each count `k` up to `plan.max_cascades` (only those whose map side is a
 /// power of two when there are any: the stable fit's whole-texel motion is exact
 /// in `f32` only there), `fit(splits, k)` fits the technique on `side(k)` texels
-/// (the tight and stable cascades are predicted by their tight fit, in the frame of
-/// [`cascade_up`]), and the 95th percentile of the aliasing error is predicted on
+/// as it will be fitted (in the frame of [`cascade_up`]; the stable cascades with
+/// the maps they hold and the margins a newly sized map takes for the camera's turn
+/// and walk, which over a room's small footprint at 128² texels cost one map up to
+/// 14% on a side, more than four maps of a quarter of the texels each lose), and
+/// the 95th percentile of the aliasing error is predicted on
 /// the same rays for every count (`shadowmap_frustum::predict_errors`, the error
 /// model of Lloyd et al. over the receivers' box within the depth bounds: camera,
 /// light and bounds alone, no rendering). One cascade is the uniform fit (or the

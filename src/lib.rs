@@ -88,8 +88,9 @@
 //! | `TiledCube` | point | one per tile | **S**, **P**, D | Arvo, *Tiled shadow maps*, over the focused cube faces: each face narrowed to its samples and cut into `TileOptions::grid`² cells, each cell as many texels as its front-lit samples need, but for the 5% of them that cost the most texels (given up greedily, kept at half the common need at least), uniform neighbours merged into one tile (a quadtree), all tiles in one atlas; the samples' layer is their tile |
 //!
 //! Cascade count: for each count `k` up to [`CascadePlan::max_cascades`] (preferring
-//! power-of-two sides), practical splits of the depth bounds are fitted tight to
-//! slice ∩ receivers on `side(k)` texels, and the count of least predicted error
+//! power-of-two sides), practical splits of the depth bounds are fitted to
+//! slice ∩ receivers on `side(k)` texels (tight, or stable with the maps the state
+//! holds and the margins of newly sized ones), and the count of least predicted error
 //! (`shadowmap_frustum::predict_errors` within the depth bounds) wins, more than one
 //! cascade only where predicted at most 0.9 times the error of one: open ground gets
 //! several cascades, a small room one map of the whole budget. One cascade fits in

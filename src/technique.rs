@@ -24,7 +24,10 @@ pub enum Technique {
     /// frames with hysteresis ([`fit_with_state`](crate::fit_with_state)), texel
     /// snapping: shadow edges do not shimmer, and the map costs the margin over the
     /// tight fit, not the whole slice's bounding sphere (which cost 1.26x here).
-    /// Count and frame as [`Technique::TightCascades`]. Directional light.
+    /// Frame as [`Technique::TightCascades`]; the count is the one of least
+    /// predicted error of the stable maps themselves, margins included (over a
+    /// small footprint one newly sized map can pay more for its margins than four
+    /// maps of a quarter of the texels each). Directional light.
     StableCascades(CascadePlan),
     /// Parallel-split shadow maps, tight fit to slice ∩ receivers over the depth
     /// bounds (SDSM-style). The count is the one of least predicted error, more than
