@@ -7,7 +7,7 @@ use crate::WarpError;
 use crate::focus::{
     Bounds, Focus, FocusBody, View, finish, frame_axis, ortho_fit, smoothstep, sqrt0,
 };
-use crate::predict::{self, Probe};
+use crate::predict::Probe;
 use crate::{MAX_WARP_RATIO, ParallelFade, SceneBounds};
 
 /// Options of [`lispsm`].
@@ -339,7 +339,7 @@ pub(crate) fn turn_invariant(
 
 /// The strength to use for a warp whose formula asks for `s_formula`: the fraction
 /// of its warp ratio, `ln(1 + s d)`, of least predicted error (see
-/// [`predict::choose`]), so that the fit degrades continuously to the uniform fit
+/// [`Probe::strength`]), so that the fit degrades continuously to the uniform fit
 /// where the formula's warp does not pay.
 pub(crate) fn predicted_strength(f: &Focus, view: &View, s_formula: f64) -> f64 {
     if !(s_formula > 0.0) {
@@ -360,12 +360,10 @@ pub(crate) fn predicted_strength(f: &Focus, view: &View, s_formula: f64) -> f64 
     };
     let mut probe = Probe::new();
     probe.fill(view, f);
-    let confidence = probe.confidence();
-    if !(confidence > 0.0) {
-        return s_formula;
-    }
-    let t = predict::choose(confidence, |t| {
-        warp_clip(f, view, s_at(t), false).map_or(f64::INFINITY, |(clip, _, _)| probe.error(&clip))
+    let t = probe.strength(|t| {
+        warp_clip(f, view, s_at(t), false)
+            .ok()
+            .map(|(clip, _, _)| clip)
     });
     s_at(t)
 }

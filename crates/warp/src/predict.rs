@@ -29,6 +29,13 @@
 //!                                      and faces within about 3° of the light
 //! ```
 //!
+//! Only front-lit faces of the box count (their weight fades with the light's angle
+//! to them). Where few are lit (a light grazing the ground, which then lights walls,
+//! fences and trunks the box does not have) the same points facing the bisector of
+//! the eye and light directions decide instead, blended by the lit share of the
+//! weight ([`Probe::strength`]): the error of the parameterization alone, Lloyd et
+//! al.'s perspective aliasing, which needs no lit surface.
+//!
 //! Every ingredient is a continuous function of the camera and the light (weights
 //! fade points in and out; only a ray that stops meeting the box altogether drops
 //! out, by then at a small floor weight), and so is the chosen strength (below):
@@ -79,10 +86,18 @@ struct Ray {
     d_dir: [DVec3; 2],
 }
 
-/// The probe points of a focus body.
+/// Most probe points of a focus body.
+const MAX_POINTS: usize = COLUMNS * ROWS * DEPTHS;
+
+/// The probe points of a focus body, twice: `points` with the normals of the
+/// receivers' box faces they lie on, weighted by how front-lit those faces are, and
+/// `perspective` at the same places facing the bisector of the eye and light
+/// directions, at their whole weight (the error of the parameterization alone,
+/// which needs no lit surface).
 #[derive(Clone, Debug)]
 pub(crate) struct Probe {
-    points: ArrayVec<Point, { COLUMNS * ROWS * DEPTHS }>,
+    points: ArrayVec<Point, MAX_POINTS>,
+    perspective: ArrayVec<Point, MAX_POINTS>,
     /// The weight the points would carry if every surface were front-lit.
     geometric: f64,
 }
@@ -125,6 +140,7 @@ impl Probe {
     pub(crate) const fn new() -> Self {
         Self {
             points: ArrayVec::new_const(),
+            perspective: ArrayVec::new_const(),
             geometric: 0.0,
         }
     }
@@ -150,7 +166,8 @@ impl Probe {
                     (column as f64 + 0.5) / COLUMNS as f64,
                     (row as f64 + 0.5) / ROWS as f64,
                 );
-                self.geometric += ray_points(&screen, &b, at, step, f.light, &mut self.points);
+                let out = (&mut self.points, &mut self.perspective);
+                self.geometric += ray_points(&screen, &b, at, step, f.light, out);
             }
         }
     }
@@ -158,34 +175,40 @@ impl Probe {
     /// The predicted error `E` of the clip matrix `clip_from_world` (infinite when
     /// a probe point falls behind its projection centre).
     pub(crate) fn error(&self, clip_from_world: &DMat4) -> f64 {
-        // Only clip x, y and w matter: the columns' (x, y, w), multiplied and summed
-        // in the order of the matrix product (a direction's zero `w` term left out).
-        let m = clip_from_world;
-        let [cx, cy, cz, cw] =
-            [m.x_axis, m.y_axis, m.z_axis, m.w_axis].map(|c| DVec3::new(c.x, c.y, c.w));
-        let (mut sum, mut weights) = (0.0, 0.0);
-        for q in &self.points {
-            let h = cx * q.p.x + cy * q.p.y + cz * q.p.z + cw;
-            let hw = h.z;
-            if !(hw > 0.0) {
-                return f64::INFINITY;
-            }
-            let ndc = |d: DVec3| {
-                let dh = cx * d.x + cy * d.y + cz * d.z;
-                (DVec2::new(dh.x, dh.y) * hw - DVec2::new(h.x, h.y) * dh.z) / (hw * hw)
-            };
-            let inv_s2 = math::inverse_square_smaller_singular_value(ndc(q.dx), ndc(q.dy));
-            if !(inv_s2 < f64::INFINITY) {
-                return f64::INFINITY;
-            }
-            sum += q.weight * pow4(inv_s2);
-            weights += q.weight;
+        points_error(&self.points, clip_from_world)
+    }
+
+    /// [`Probe::error`] with every point facing the bisector of the eye and light
+    /// directions: the perspective-only error.
+    pub(crate) fn perspective_error(&self, clip_from_world: &DMat4) -> f64 {
+        points_error(&self.perspective, clip_from_world)
+    }
+
+    /// The fraction `t` in `[0, 1]` of a warp's formula strength to use, from its
+    /// clip matrix at a strength `t` (`None` where the fit fails): [`choose`] on the
+    /// predicted error, blended by [`Probe::confidence`] with [`choose`] on the
+    /// perspective-only error. Where the receivers' box shows few front-lit faces
+    /// (a light that grazes the ground, whose visible surfaces are then walls,
+    /// fences and trunks the box does not have) the parameterization alone decides:
+    /// falling back to the formula instead kept XPSM's length at a fence lit from
+    /// 3° above the horizon, predicted 2x the uniform fit's error and measured 1.57x.
+    /// Each fit is computed once for both errors.
+    pub(crate) fn strength(&self, mut clip_at: impl FnMut(f64) -> Option<DMat4>) -> f64 {
+        let confidence = self.confidence();
+        let mut clips: [Option<Option<DMat4>>; GRID] = [None; GRID];
+        let mut clip = |t: f64| {
+            let i = ((t * (GRID - 1) as f64).round() as usize).min(GRID - 1);
+            *clips[i].get_or_insert_with(|| clip_at(t))
+        };
+        let lit = (confidence > 0.0)
+            .then(|| choose(|t| clip(t).map_or(f64::INFINITY, |c| self.error(&c))));
+        if let (Some(t), true) = (lit, confidence >= 1.0) {
+            return t;
         }
-        if weights > 0.0 {
-            math::powf(sum / weights, 1.0 / f64::from(POWER))
-        } else {
-            0.0
-        }
+        let perspective = choose(|t| clip(t).map_or(f64::INFINITY, |c| self.perspective_error(&c)));
+        lit.map_or(perspective, |t| {
+            perspective + (t - perspective) * confidence
+        })
     }
 
     /// How far the prediction is to be trusted, in `[0, 1]`: 0 when no probe point
@@ -199,6 +222,39 @@ impl Probe {
         } else {
             0.0
         }
+    }
+}
+
+/// The power mean `E` of the aliasing error over `points` for `clip_from_world`
+/// (see [`Probe::error`]).
+fn points_error(points: &[Point], clip_from_world: &DMat4) -> f64 {
+    // Only clip x, y and w matter: the columns' (x, y, w), multiplied and summed
+    // in the order of the matrix product (a direction's zero `w` term left out).
+    let m = clip_from_world;
+    let [cx, cy, cz, cw] =
+        [m.x_axis, m.y_axis, m.z_axis, m.w_axis].map(|c| DVec3::new(c.x, c.y, c.w));
+    let (mut sum, mut weights) = (0.0, 0.0);
+    for q in points {
+        let h = cx * q.p.x + cy * q.p.y + cz * q.p.z + cw;
+        let hw = h.z;
+        if !(hw > 0.0) {
+            return f64::INFINITY;
+        }
+        let ndc = |d: DVec3| {
+            let dh = cx * d.x + cy * d.y + cz * d.z;
+            (DVec2::new(dh.x, dh.y) * hw - DVec2::new(h.x, h.y) * dh.z) / (hw * hw)
+        };
+        let inv_s2 = math::inverse_square_smaller_singular_value(ndc(q.dx), ndc(q.dy));
+        if !(inv_s2 < f64::INFINITY) {
+            return f64::INFINITY;
+        }
+        sum += q.weight * pow4(inv_s2);
+        weights += q.weight;
+    }
+    if weights > 0.0 {
+        math::powf(sum / weights, 1.0 / f64::from(POWER))
+    } else {
+        0.0
     }
 }
 
@@ -218,7 +274,10 @@ fn ray_points(
     at: DVec2,
     step: DVec2,
     light: DVec3,
-    out: &mut ArrayVec<Point, { COLUMNS * ROWS * DEPTHS }>,
+    (out, perspective): (
+        &mut ArrayVec<Point, MAX_POINTS>,
+        &mut ArrayVec<Point, MAX_POINTS>,
+    ),
 ) -> f64 {
     let ray = screen.ray(at.x, at.y);
     let (o, d) = (ray.origin, ray.dir);
@@ -255,13 +314,12 @@ fn ray_points(
     };
     let beta = if s_exit < 1.0 { log_step(zf / z1) } else { 0.0 };
     let point = |s: f64, n: DVec3, weight: f64| point_at(&ray, step, s, n, weight);
-    let probe = |s: f64, n: DVec3, weight: f64| {
-        // Only front-lit surfaces matter: within about 3° of parallel to the light
-        // shading darkens a surface whatever the map says (and its texels stretch
-        // without bound), so such faces fade out between sin 3° and sin 6°.
-        let lit = smoothstep(0.05, 0.1, -n.dot(light));
-        point(s, n, weight * lit)
-    };
+    // The bisector of the eye and light directions; where the light comes straight
+    // at the viewer it vanishes, and the points facing it fade out.
+    let to_eye = -d.normalize_or_zero();
+    let bisector = to_eye - light;
+    let facing = bisector.length();
+    let (n_bisector, w_bisector) = (bisector / facing, smoothstep(0.0, 0.1, facing));
     let face = |s_face: f64, slabs: &[f64; 3]| {
         let mut n = DVec3::ZERO;
         let depth_face = depth(s_face);
@@ -279,37 +337,42 @@ fn ray_points(
         }
         n.normalize_or_zero()
     };
-    let mut push = |q: Option<Point>| {
+    let mut push = |q: Option<Point>, bisecting: Option<Point>| {
         if let Some(q) = q.filter(|q| q.weight > 0.0) {
             let _ = out.try_push(q);
         }
+        if let Some(q) = bisecting.filter(|q| q.weight > 0.0) {
+            let _ = perspective.try_push(q);
+        }
+    };
+    // A face point: on the face with its normal where front-lit (only front-lit
+    // surfaces matter: within about 3° of parallel to the light shading darkens a
+    // surface whatever the map says, and its texels stretch without bound, so such
+    // faces fade out between sin 3° and sin 6°), and facing the bisector.
+    let mut face_point = |s: f64, n: DVec3, weight: f64| {
+        let lit = smoothstep(0.05, 0.1, -n.dot(light));
+        push(
+            point(s, n, weight * lit),
+            point(s, n_bisector, weight * w_bisector),
+        );
     };
     if alpha > 0.0 {
-        push(probe(s0, face(s0, &enter), ray_weight * alpha));
+        face_point(s0, face(s0, &enter), ray_weight * alpha);
     }
     let w_exit = ray_weight * (1.0 - alpha) * beta;
     if w_exit > 0.0 {
-        push(probe(s1, face(s1, &exit), w_exit));
+        face_point(s1, face(s1, &exit), w_exit);
     }
-    let w_volume = ray_weight * (1.0 - alpha) * (1.0 - beta) / DEPTHS as f64;
+    let w_volume = ray_weight * (1.0 - alpha) * (1.0 - beta) / DEPTHS as f64 * w_bisector;
     if !(w_volume > 0.0) {
         return ray_weight;
     }
-    let to_eye = -d.normalize_or_zero();
-    let bisector = to_eye - light;
-    let facing = bisector.length();
-    // Where the light comes straight at the viewer the bisector vanishes: the
-    // points fade out.
-    let w_volume = w_volume * smoothstep(0.0, 0.1, facing);
-    if !(w_volume > 0.0) {
-        return ray_weight;
-    }
-    let n = bisector / facing;
     // Depths `z0 (z1 / z0)^((k + 1/2) / DEPTHS)`: odd powers of the eighth root.
     let root = math::sqrt(math::sqrt(math::sqrt(z1 / z0)));
     let mut z = z0 * root;
     for _ in 0..DEPTHS {
-        push(point((z - zn) / (zf - zn), n, w_volume));
+        let q = point((z - zn) / (zf - zn), n_bisector, w_volume);
+        push(q, q);
         z *= root * root;
     }
     ray_weight
@@ -382,12 +445,11 @@ const KEEP_BELOW: f64 = 0.9;
 /// error, the formula's strength is kept (`t = 1`): the paper's parameter where it
 /// clearly pays. Otherwise `t` is the minimum of the parabola through the smallest
 /// predicted error and its two neighbours on the grid, blended toward 1 as the
-/// ratio falls from 1 to [`KEEP_BELOW`], and toward 1 as the probe's
-/// `confidence` ([`Probe::confidence`]) falls to 0. Each step is continuous in the predicted
+/// ratio falls from 1 to [`KEEP_BELOW`]. Each step is continuous in the predicted
 /// errors (the parabola's minimum moves continuously as the smallest grid point
 /// changes, since the two parabolas then agree at the midpoint), so the strength is
 /// continuous in the camera and the light.
-pub(crate) fn choose(confidence: f64, mut error: impl FnMut(f64) -> f64) -> f64 {
+pub(crate) fn choose(mut error: impl FnMut(f64) -> f64) -> f64 {
     let at = |i: usize| i as f64 / (GRID - 1) as f64;
     let mut e = [0.0f64; GRID];
     // The ends first: they alone decide the usual cases.
@@ -406,7 +468,7 @@ pub(crate) fn choose(confidence: f64, mut error: impl FnMut(f64) -> f64) -> f64 
         *slot = error(at(i));
     }
     let t_opt = parabola_min(&e) / (GRID - 1) as f64;
-    let keep = 1.0 - smoothstep(KEEP_BELOW, 1.0, q) * confidence.clamp(0.0, 1.0);
+    let keep = 1.0 - smoothstep(KEEP_BELOW, 1.0, q);
     (t_opt + (1.0 - t_opt) * keep).clamp(0.0, 1.0)
 }
 
@@ -436,6 +498,53 @@ fn parabola_min(e: &[f64; GRID]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A probe whose points face the bisector only (`lit` of their weight on the
+    /// box's faces): a grazing light, where no face of the receivers' box is lit.
+    fn probe(lit: f64) -> Probe {
+        let mut probe = Probe::new();
+        for k in 0..4 {
+            // Steps across x are the smaller on the bisector's plane...
+            let q = Point {
+                p: DVec3::new(f64::from(k), 0.5, -2.0),
+                dx: DVec3::new(1e-3, 0.0, 0.0),
+                dy: DVec3::new(0.0, 1.0, 0.0),
+                weight: 1.0,
+            };
+            probe.perspective.push(q);
+            if lit > 0.0 {
+                // ... and down y on the lit faces.
+                probe.points.push(Point {
+                    weight: lit,
+                    dx: DVec3::new(1.0, 0.0, 0.0),
+                    dy: DVec3::new(0.0, 1e-3, 0.0),
+                    ..q
+                });
+            }
+            probe.geometric += 1.0;
+        }
+        probe
+    }
+
+    /// With no front-lit face the strength is the one of least perspective-only
+    /// error, not the formula's: a warp whose full strength doubles the texels'
+    /// size (here the map shrinks as `t` grows) is not taken.
+    #[test]
+    fn without_lit_faces_the_perspective_error_chooses() {
+        let clip = |t: f64| Some(DMat4::from_scale(DVec3::new(2.0 - t, 2.0 - t, 1.0)));
+        let unlit = probe(0.0);
+        assert_eq!(unlit.confidence(), 0.0);
+        let t = unlit.strength(clip);
+        assert!(t < 0.05, "{t}");
+        // Fully confident, the lit faces' error decides: a map that grows along y
+        // and shrinks along x as `t` grows serves them best at `t = 1`, the
+        // bisector's plane at `t = 0`.
+        let squeeze = |t: f64| Some(DMat4::from_scale(DVec3::new(2.0 - t, 0.5 + t, 1.0)));
+        let lit = probe(1.0);
+        assert_eq!(lit.confidence(), 1.0);
+        assert!(lit.strength(squeeze) > 0.95);
+        assert!(unlit.strength(squeeze) < 0.5);
+    }
 
     /// Where the ray through screen position `(x, y)` meets the plane through `p`
     /// with normal `n`.

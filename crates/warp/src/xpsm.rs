@@ -8,7 +8,7 @@ use crate::FocusBody;
 use crate::WarpError;
 use crate::focus::{Bounds, Focus, View, finish, scale_of, smoothstep};
 use crate::lispsm::turn_invariant;
-use crate::predict::{self, Probe};
+use crate::predict::Probe;
 use shadowmap_frustum::math;
 
 /// Options of [`xpsm`].
@@ -314,12 +314,10 @@ fn predicted_length(view: &View, f: &Focus, options: &XpsmOptions, length: f64, 
     };
     let mut probe = Probe::new();
     probe.fill(view, f);
-    let confidence = probe.confidence();
-    if !(confidence > 0.0) {
-        return length;
-    }
-    let t = predict::choose(confidence, |t| {
-        xpsm_fit(view, f, options, at(t), shift).map_or(f64::INFINITY, |fit| probe.error(&fit.clip))
+    let t = probe.strength(|t| {
+        xpsm_fit(view, f, options, at(t), shift)
+            .ok()
+            .map(|fit| fit.clip)
     });
     at(t)
 }
