@@ -3,9 +3,7 @@ use glam::{DVec2, DVec3, Mat4, Vec3};
 
 use crate::cascade_fit::Fitter;
 use crate::cascade_state::CascadeState;
-use crate::mapping::{
-    LightDirection, ShadowSample, ShadowTransform, project_dmat, projective_uv_differentials,
-};
+use crate::mapping::{ShadowSample, ShadowTransform, project_dmat, projective_uv_differentials};
 use crate::split::CascadeBlend;
 use crate::{
     Camera, CascadeSplits, FrustumError, MAX_CASCADES, SceneBounds, ShadowMapping, ValidCamera,
@@ -137,24 +135,6 @@ pub struct Cascade {
     pub receivers_missed: bool,
 }
 
-impl Cascade {
-    /// A cascade's place before it is fitted (zeros: cheap to write).
-    pub(crate) const PLACEHOLDER: Self = Self {
-        view_depth: (0.0, 0.0),
-        transform: ShadowTransform {
-            light_from_world: Mat4::ZERO,
-            clip_from_world: Mat4::ZERO,
-            uv_from_world: Mat4::ZERO,
-            reversed_z: false,
-            light: LightDirection::Directional(Vec3::ZERO),
-        },
-        texel_world_size: 0.0,
-        light_depth: (0.0, 0.0),
-        caster_depth: None,
-        receivers_missed: false,
-    };
-}
-
 /// A fitted set of cascades for a directional light.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -237,7 +217,6 @@ impl CascadeSet {
         splits: &CascadeSplits,
         options: &CascadeOptions,
     ) -> Result<(), FrustumError> {
-        self.cascades.clear();
         self.splits.clone_from(splits);
         self.view_from_world = camera.geometry.view_from_world32;
         self.resolution = options.resolution;
@@ -306,24 +285,20 @@ impl CascadeSet {
         let checked = Fitter::check(light_direction, options)?;
         let fitter = Fitter::new(&camera.geometry, checked, options);
         let (splits, set) = (&self.splits, &mut self.cascades);
+        // Cascades of an earlier fit (a refit) are overwritten where they are: every
+        // fit writes every field.
+        set.truncate(splits.count());
         for i in 0..splits.count() {
             let (near, far) = splits
                 .cascade_range(i)
                 .ok_or(FrustumError::InvalidCascadeCount)?;
-            let held = state.as_deref_mut().and_then(|s| s.slot(i));
-            // Fitted where it is kept: a cascade is large, and moving it out of a
-            // `Result` and into the set would copy it twice.
-            set.try_push(Cascade::PLACEHOLDER)
-                .map_err(|_| FrustumError::InvalidCascadeCount)?;
-            let Some(cascade) = set.last_mut() else {
-                return Err(FrustumError::InvalidCascadeCount);
-            };
-            match fitter.fit_into(near, far, held, cascade) {
-                Err(FrustumError::SliceOutsideScene) => {
-                    fitter.fit_without_receivers(near, far, cascade)?;
-                    cascade.receivers_missed = true;
-                }
-                other => other?,
+            // By value, stored in each branch: without scene bounds the fit is
+            // inline and its fields go straight to the set.
+            if fitter.has_scene() {
+                let held = state.as_deref_mut().and_then(|s| s.slot(i));
+                keep(set, i, fitter.fit_or_whole(near, far, held)?)?;
+            } else {
+                keep(set, i, fitter.fit(near, far, None)?)?;
             }
         }
         Ok(())
@@ -350,6 +325,23 @@ impl CascadeSet {
             })
         })
     }
+}
+
+/// Stores cascade `i` of a set being fitted: over the one an earlier fit left there,
+/// or as the next.
+#[inline(always)]
+fn keep(
+    set: &mut ArrayVec<Cascade, MAX_CASCADES>,
+    i: usize,
+    cascade: Cascade,
+) -> Result<(), FrustumError> {
+    match set.get_mut(i) {
+        Some(kept) => *kept = cascade,
+        None => set
+            .try_push(cascade)
+            .map_err(|_| FrustumError::InvalidCascadeCount)?,
+    }
+    Ok(())
 }
 
 impl ShadowMapping for CascadeSet {

@@ -42,8 +42,10 @@ pub(crate) struct Fitter<'a> {
     light_from_world: DMat4,
     /// `light_from_world` in `f32`, as stored in every cascade.
     light_from_world32: Mat4,
-    /// `light_from_world * world_from_view`: slice corners go to light space in one step.
-    light_from_view: DMat4,
+    /// The eye and the view axis (view-space `+Z`) in light space: the centre of a
+    /// symmetric pinhole slice's sphere lies on that axis.
+    eye_light: DVec3,
+    axis_light: DVec3,
     /// The camera's edge rays in light space (see [`CameraGeometry`]).
     light_rays: Rays,
     options: CascadeOptions,
@@ -77,25 +79,26 @@ impl<'a> Fitter<'a> {
     }
 
     /// The fitter of checked input ([`Fitter::check`]); infallible, so it is built
-    /// where it is used rather than moved out of a `Result`.
+    /// where it is used rather than moved out of a `Result`, and inline, so that its
+    /// parts are computed where the fitter is kept rather than copied there.
+    #[inline(always)]
     pub(crate) fn new(
         camera: &'a CameraGeometry,
         (light_dir, scene): (DVec3, Option<SceneBounds>),
         options: &CascadeOptions,
     ) -> Self {
         let light_from_world = crate::projection::light_rotation(light_dir, options.up_hint);
-        let light_from_view = light_from_world * camera.world_from_view;
+        let view = &camera.world_from_view;
         Self {
             camera,
             light_dir,
             light_from_world,
             light_from_world32: light_from_world.as_mat4(),
-            light_from_view,
+            eye_light: light_from_world.transform_point3(view.w_axis.truncate()),
+            axis_light: light_from_world.transform_vector3(view.z_axis.truncate()),
             // The stable fit reads only the light depth of the slice's corners.
-            light_rays: Rays::axes(
-                &light_from_view,
-                &camera.ray_origin,
-                &camera.ray_dir,
+            light_rays: camera.world_rays.mapped(
+                &light_from_world,
                 if options.fit == CascadeFit::Stable {
                     2..3
                 } else {
@@ -107,138 +110,154 @@ impl<'a> Fitter<'a> {
         }
     }
 
-    /// The stable size ladder's step, when it applies (stable fit with scene bounds).
-    fn ladder_step(&self) -> Option<f64> {
-        match (self.options.fit, &self.scene, self.options.stable_size_step) {
-            (CascadeFit::Stable, Some(_), Some(step)) => Some(f64::from(step)),
-            _ => None,
-        }
+    /// Whether the fit has scene bounds.
+    pub(crate) fn has_scene(&self) -> bool {
+        self.scene.is_some()
     }
 
-    pub(crate) fn fit_without_receivers(
+    /// [`Fitter::fit`], falling back to the whole slice, without the receivers and
+    /// casters of the scene bounds, for a slice that misses the receivers (marked
+    /// [`Cascade::receivers_missed`]).
+    #[inline(never)]
+    pub(crate) fn fit_or_whole(
         &self,
         near: f32,
         far: f32,
-        out: &mut Cascade,
-    ) -> Result<(), FrustumError> {
-        let receiverless = Self {
-            scene: None,
-            ..*self
-        };
-        receiverless.fit_into(near, far, None, out)
+        held: Option<HeldSlot<'_>>,
+    ) -> Result<Cascade, FrustumError> {
+        match self.fit(near, far, held) {
+            Err(FrustumError::SliceOutsideScene) => {
+                let (n, f) = self.camera.check_slice(near, far)?;
+                let mut whole = self.fit_slice(n, f, None)?;
+                whole.receivers_missed = true;
+                Ok(whole)
+            }
+            fitted => fitted,
+        }
     }
 
     /// The bounding sphere of the slice between view depths `n < f`
     /// ([`bounding_sphere`]), its centre in light space: in closed form for a
     /// symmetric pinhole camera, whose centre lies on the view axis.
+    #[inline(always)]
     fn slice_sphere(&self, n: f64, f: f64) -> (DVec3, f64) {
         match self.camera.symmetric_k {
             Some(k) => {
                 let (depth, radius) = symmetric_slice_sphere(k, n, f);
                 // View-space (0, 0, -depth) in light space.
-                let m = &self.light_from_view;
-                (m.w_axis.truncate() - m.z_axis.truncate() * depth, radius)
+                (self.eye_light - self.axis_light * depth, radius)
             }
             None => {
                 let (center, radius) = bounding_sphere(&self.camera.view_corners(n, f));
-                (self.light_from_view.transform_point3(center), radius)
+                let world = self.camera.world_from_view.transform_point3(center);
+                (self.light_from_world.transform_point3(world), radius)
             }
         }
     }
 
     /// Fits the slice `[near, far]`; `held` is the caller-held map of the stable
     /// fit (see [`CascadeState`]), used only with the stable fit and scene bounds.
-    fn fit(
+    /// Inline, by value: without scene bounds the cascade's fields are written
+    /// straight to where the caller keeps it.
+    #[inline(always)]
+    pub(crate) fn fit(
         &self,
         near: f32,
         far: f32,
         held: Option<HeldSlot<'_>>,
     ) -> Result<Cascade, FrustumError> {
-        let mut cascade = Cascade::PLACEHOLDER;
-        self.fit_into(near, far, held, &mut cascade)?;
-        Ok(cascade)
+        let (n, f) = self.camera.check_slice(near, far)?;
+        match &self.scene {
+            Some(scene) => self.fit_scene(n, f, scene, held),
+            None => self.fit_slice(n, f, None),
+        }
     }
 
-    /// [`Fitter::fit`] into `out` (unchanged on error).
-    pub(crate) fn fit_into(
+    /// The whole slice `[n, f]`: the light-space box of its corners (tight) or of
+    /// its bounding sphere (stable), its near plane pulled back to `casters`. Inline
+    /// with [`Fitter::finish`]: the fit of a set without scene bounds is this, once
+    /// per slice, and calls cost more than its steps.
+    #[inline(always)]
+    fn fit_slice(&self, n: f64, f: f64, casters: Option<&Aabb>) -> Result<Cascade, FrustumError> {
+        let res = f64::from(self.options.resolution);
+        let (xy_lo, xy_hi, texel, z) = match self.options.fit {
+            CascadeFit::Stable => {
+                // The sphere sizes the box: of the corners only the depth range is read.
+                let z = self.light_rays.range(2, n, f);
+                let (center, radius) = self.slice_sphere(n, f);
+                let (a, b, texel) = sphere_box(center.truncate(), radius, res)?;
+                (a, b, texel, z)
+            }
+            CascadeFit::Tight => {
+                let (lo, hi) = self.light_rays.bounds(n, f);
+                let (a, b, texel) = tight_box(lo, hi, res);
+                (a, b, texel, (lo.z, hi.z))
+            }
+        };
+        let fitted = FittedBox {
+            xy_lo,
+            xy_hi,
+            texel,
+            depth: (-z.1, -z.0),
+            // The slice's corners, read only if the invertibility test needs them.
+            reach: None,
+        };
+        let frame = Frame {
+            light_from_world: &self.light_from_world,
+            light_from_world32: &self.light_from_world32,
+        };
+        self.finish(n, f, &frame, &fitted, casters)
+    }
+
+    /// The slice `[n, f]` ∩ receivers: held across frames ([`Fitter::fit_held`]),
+    /// or its light-space box (tight), the box of the slice's sphere (stable), or a
+    /// rung of the size ladder over it (stable with
+    /// [`CascadeOptions::stable_size_step`]).
+    fn fit_scene(
         &self,
-        near: f32,
-        far: f32,
+        n: f64,
+        f: f64,
+        scene: &SceneBounds,
         held: Option<HeldSlot<'_>>,
-        out: &mut Cascade,
-    ) -> Result<(), FrustumError> {
-        let (n, f) = self.camera.check_slice(near, far)?;
-        if let (Some(scene), CascadeFit::Stable, Some(mut held)) =
-            (&self.scene, self.options.fit, held)
-        {
-            return self.fit_held(n, f, scene, &mut held, out);
+    ) -> Result<Cascade, FrustumError> {
+        if let (CascadeFit::Stable, Some(mut held)) = (self.options.fit, held) {
+            return self.fit_held(n, f, scene, &mut held);
         }
         let light = &self.light_from_world;
-        let mut lo = DVec3::splat(f64::INFINITY);
-        let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        // Largest world coordinate of the fitted points, for the invertibility test
-        // (of the slice's corners, computed only if that test needs it).
-        let mut reach = None;
-        match &self.scene {
-            Some(scene) => {
-                let body = self.receivers_body(n, f, scene)?;
-                let mut max_abs = 0.0f64;
-                for v in body.vertices() {
-                    let p = v.as_dvec3();
-                    max_abs = max_abs.max(p.abs().max_element());
-                    let q = light.transform_point3(p);
-                    lo = lo.min(q);
-                    hi = hi.max(q);
-                }
-                reach = Some(max_abs);
-            }
-            // The stable fit sizes the box by the slice's sphere: only the depth range
-            // is needed.
-            None if self.options.fit == CascadeFit::Stable => {
-                (lo.z, hi.z) = self.light_rays.range(2, n, f);
-            }
-            None => (lo, hi) = self.light_rays.bounds(n, f),
+        let body = self.receivers_body(n, f, scene)?;
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        // Largest world coordinate of the fitted points, for the invertibility test.
+        let mut reach = 0.0f64;
+        for v in body.vertices() {
+            let p = v.as_dvec3();
+            reach = reach.max(p.abs().max_element());
+            let q = light.transform_point3(p);
+            lo = lo.min(q);
+            hi = hi.max(q);
         }
         let res = f64::from(self.options.resolution);
-        let (xy_lo, xy_hi, texel) = match self.options.fit {
-            CascadeFit::Tight => {
-                let size = (hi - lo).truncate();
-                let scale = lo.abs().max(hi.abs()).max_element().max(1e-30);
-                // A slice seen edge-on from the light is flat: give it a sliver of area.
-                let pad = (DVec2::splat(1e-6 * scale) - size).max(DVec2::ZERO) * 0.5;
-                let (a, b) = (lo.truncate() - pad, hi.truncate() + pad);
-                (a, b, (b - a).max_element() / res)
+        let (xy_lo, xy_hi, texel) = match (self.options.fit, self.options.stable_size_step) {
+            (CascadeFit::Tight, _) => tight_box(lo, hi, res),
+            (CascadeFit::Stable, Some(step)) => {
+                ladder_box(lo.truncate(), hi.truncate(), f64::from(step), res)?
             }
-            CascadeFit::Stable if self.ladder_step().is_some() => {
-                let step = self.ladder_step().unwrap_or(2.0);
-                ladder_box(lo.truncate(), hi.truncate(), step, res)?
-            }
-            CascadeFit::Stable => {
+            (CascadeFit::Stable, None) => {
                 let (center, radius) = self.slice_sphere(n, f);
-                // One texel of slack on each side absorbs the snap (at most half a texel).
-                let texel = 2.0 * radius / (res - 2.0);
-                if !(texel > 0.0 && texel.is_finite()) {
-                    return Err(FrustumError::EmptyBounds);
-                }
-                let snapped =
-                    DVec2::new(math::round(center.x / texel), math::round(center.y / texel))
-                        * texel;
-                let half = DVec2::splat(0.5 * res * texel);
-                (snapped - half, snapped + half, texel)
+                sphere_box(center.truncate(), radius, res)?
             }
         };
         let frame = Frame {
-            light_from_world: *light,
-            light_from_world32: self.light_from_world32,
+            light_from_world: light,
+            light_from_world32: &self.light_from_world32,
         };
         let fitted = FittedBox {
             xy_lo,
             xy_hi,
             texel,
             depth: (-hi.z, -lo.z),
-            reach,
+            reach: Some(reach),
         };
-        self.finish(n, f, &frame, &fitted, out)
+        self.finish_scene(n, f, &frame, &fitted, scene)
     }
 
     /// The vertices of slice `[n, f]` ∩ receivers. A slice too thin to clip
@@ -271,8 +290,7 @@ impl<'a> Fitter<'a> {
         f: f64,
         scene: &SceneBounds,
         held: &mut HeldSlot<'_>,
-        out: &mut Cascade,
-    ) -> Result<(), FrustumError> {
+    ) -> Result<Cascade, FrustumError> {
         let body = self.receivers_body(n, f, scene)?;
         let points = body.vertices().iter().map(|v| v.as_dvec3());
         let b = held_box(
@@ -290,8 +308,8 @@ impl<'a> Fitter<'a> {
             z_hi = z_hi.max(z);
         }
         let frame = Frame {
-            light_from_world: b.light_from_world,
-            light_from_world32: b.light_from_world.as_mat4(),
+            light_from_world: &b.light_from_world,
+            light_from_world32: &b.light_from_world.as_mat4(),
         };
         let fitted = FittedBox {
             xy_lo: b.lo,
@@ -300,20 +318,35 @@ impl<'a> Fitter<'a> {
             depth: (-z_hi, -z_lo),
             reach: Some(reach),
         };
-        self.finish(n, f, &frame, &fitted, out)
+        self.finish_scene(n, f, &frame, &fitted, scene)
+    }
+
+    /// [`Fitter::finish`] with the scene's casters, in one place for the fits with
+    /// scene bounds.
+    #[inline(never)]
+    fn finish_scene(
+        &self,
+        n: f64,
+        f: f64,
+        frame: &Frame<'_>,
+        fitted: &FittedBox,
+        scene: &SceneBounds,
+    ) -> Result<Cascade, FrustumError> {
+        self.finish(n, f, frame, fitted, Some(&scene.casters))
     }
 
     /// The cascade of slice `[n, f]` for the light-space rectangle of `fitted` in
     /// `frame`: depth range pulled back to the casters over it, matrices, checks.
+    #[inline(always)]
     fn finish(
         &self,
         n: f64,
         f: f64,
-        frame: &Frame,
+        frame: &Frame<'_>,
         fitted: &FittedBox,
-        out: &mut Cascade,
-    ) -> Result<(), FrustumError> {
-        let light = &frame.light_from_world;
+        casters: Option<&Aabb>,
+    ) -> Result<Cascade, FrustumError> {
+        let light = frame.light_from_world;
         let FittedBox {
             xy_lo,
             xy_hi,
@@ -324,8 +357,8 @@ impl<'a> Fitter<'a> {
         // Light space looks down -Z: distance from the light is -z.
         let (mut near_dist, far_dist) = fitted.depth;
         let mut caster_depth = None;
-        if let Some(scene) = &self.scene {
-            if let Some((c_near, c_far)) = caster_depth_over(light, &scene.casters, xy_lo, xy_hi)? {
+        if let Some(casters) = casters {
+            if let Some((c_near, c_far)) = caster_depth_over(light, casters, xy_lo, xy_hi)? {
                 caster_depth = Some((c_near as f32, c_far as f32));
                 near_dist = near_dist.min(c_near);
             }
@@ -360,28 +393,28 @@ impl<'a> Fitter<'a> {
             return Err(FrustumError::DegenerateFrustum);
         }
         let transform = ShadowTransform::new(
-            frame.light_from_world32,
+            *frame.light_from_world32,
             clip_from_world,
             self.options.reversed_z,
             LightDirection::Directional(self.light_dir.as_vec3()),
         );
-        *out = Cascade {
+        Ok(Cascade {
             view_depth: (n as f32, f as f32),
             transform,
             texel_world_size: texel as f32,
             light_depth: (near_dist as f32, far_dist as f32),
             caster_depth,
             receivers_missed: false,
-        };
-        Ok(())
+        })
     }
 }
 
-/// The light frame a cascade is fitted in.
-struct Frame {
-    light_from_world: DMat4,
+/// The light frame a cascade is fitted in (borrowed: a fit reads it, and copying it
+/// for every slice costs more than the reads).
+struct Frame<'m> {
+    light_from_world: &'m DMat4,
     /// `light_from_world` in `f32`, as stored in the cascade.
-    light_from_world32: Mat4,
+    light_from_world32: &'m Mat4,
 }
 
 /// A cascade's fitted light-space rectangle and depth range, before the casters.
@@ -395,6 +428,32 @@ struct FittedBox {
     /// Largest world coordinate of the fitted points, for the invertibility test
     /// (`None`: not computed; the slice's extent is then read if the test needs it).
     reach: Option<f64>,
+}
+
+/// The tight box of the light-space bounds `[lo, hi]` (a footprint seen edge-on
+/// given a sliver of area) and its texel size (the larger side's).
+fn tight_box(lo: DVec3, hi: DVec3, res: f64) -> (DVec2, DVec2, f64) {
+    let size = (hi - lo).truncate();
+    let scale = lo.abs().max(hi.abs()).max_element().max(1e-30);
+    let pad = (DVec2::splat(1e-6 * scale) - size).max(DVec2::ZERO) * 0.5;
+    let (a, b) = (lo.truncate() - pad, hi.truncate() + pad);
+    (a, b, (b - a).max_element() / res)
+}
+
+/// The stable box of a sphere, light-space centre `center` (x, y) and `radius`:
+/// side `res` texels of `2 radius / (res - 2)` (one texel of slack on each side
+/// absorbs the snap, at most half a texel), centre snapped to whole texels. Returns
+/// the box and its texel size.
+#[inline]
+fn sphere_box(center: DVec2, radius: f64, res: f64) -> Result<(DVec2, DVec2, f64), FrustumError> {
+    let texel = 2.0 * radius / (res - 2.0);
+    if !math::positive_finite(texel) {
+        return Err(FrustumError::EmptyBounds);
+    }
+    let q = center / texel;
+    let snapped = DVec2::new(math::round(q.x), math::round(q.y)) * texel;
+    let half = DVec2::splat(0.5 * res * texel);
+    Ok((snapped - half, snapped + half, texel))
 }
 
 /// The stable box over the light-space footprint `[lo, hi]` with a ladder of sizes:

@@ -1,6 +1,6 @@
 use glam::{DVec3, Vec3};
 
-use crate::FrustumError;
+use crate::{FrustumError, math};
 
 /// A light source.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,10 +85,16 @@ pub(crate) fn unit(v: Vec3) -> Result<DVec3, FrustumError> {
     if !v.is_finite() {
         return Err(FrustumError::NonFinite);
     }
-    v.as_dvec3()
-        .try_normalize()
-        .filter(|u| u.length_squared() > 0.5)
-        .ok_or(FrustumError::ZeroDirection)
+    // `DVec3::try_normalize`, with its reciprocal length tested in integer
+    // comparisons ([`math::positive_finite`]) rather than a float classification.
+    let d = v.as_dvec3();
+    let rcp = 1.0 / d.length();
+    let u = d * rcp;
+    if math::positive_finite(rcp) && u.length_squared() > 0.5 {
+        Ok(u)
+    } else {
+        Err(FrustumError::ZeroDirection)
+    }
 }
 
 /// Rotation-only light frame looking along `direction` (light space looks down `-Z`).

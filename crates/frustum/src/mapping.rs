@@ -291,6 +291,9 @@ pub fn is_invertible(m: &Mat4, world_scale: f32) -> bool {
 /// so every pair of rows is far from parallel (`sin² >= 1e-4 > 1e-12`), the
 /// determinant is finite and non-zero, and `1e-60 <= s |a_i| <= 1e60` keeps the
 /// squared norms and their products finite and non-zero.
+///
+/// Inline: a dozen comparisons, once per cascade, where a call costs as much.
+#[inline(always)]
 pub(crate) fn ortho_rotation_invertible(scale: DVec3, offset: DVec3, world_scale: f64) -> bool {
     // One row at a time, every comparison false for NaN.
     let row = |a: f64, o: f64| {

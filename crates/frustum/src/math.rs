@@ -54,27 +54,30 @@ unary! {
 }
 
 /// Nearest integer, halves away from zero: `f64::round`, inline (on x86-64 without
-/// SSE4.1 `f64::round` is a library call). Exact: below `2^52` truncation through
-/// `i64` and the fraction `x - trunc(x)` are exact, and the sign of `x` is kept
+/// SSE4.1 `f64::round` is a library call) and without branches. Exact: below `2^52`,
+/// `|x| + 2^52` lies where the doubles are the integers, so the sum rounds `|x|` to
+/// the nearest integer `t` (halves to even) and subtracting `2^52` is exact; a half
+/// rounded down (`|x| - t == 0.5`, exact) goes up instead. The sign of `x` is kept
 /// (`round(-0.3) == -0.0`); larger magnitudes, infinities and NaN are returned as
 /// they are.
 #[inline]
 #[must_use]
 pub fn round(x: f64) -> f64 {
     const INTEGRAL: f64 = 4_503_599_627_370_496.0; // 2^52
-    if !(x.abs() < INTEGRAL) {
-        return x;
-    }
-    let t = (x as i64) as f64;
-    let fraction = x - t;
-    let r = if fraction >= 0.5 {
-        t + 1.0
-    } else if fraction <= -0.5 {
-        t - 1.0
-    } else {
-        t
-    };
-    r.copysign(x)
+    let a = x.abs();
+    let t = (a + INTEGRAL) - INTEGRAL;
+    let r = if a - t == 0.5 { t + 1.0 } else { t };
+    if a < INTEGRAL { r.copysign(x) } else { x }
+}
+
+/// Whether `x` is positive and finite (`x > 0.0 && x < f64::INFINITY`), as one
+/// integer comparison: the bits of a positive finite double, less one, lie below
+/// those of infinity, less one, and those of zero, negative numbers and NaN do not
+/// (the float comparisons compile to a longer classification).
+#[inline]
+#[must_use]
+pub fn positive_finite(x: f64) -> bool {
+    x.to_bits().wrapping_sub(1) < f64::INFINITY.to_bits() - 1
 }
 
 /// The smaller of two numbers, for arguments that are not NaN (then it is `f64::min`,
@@ -217,6 +220,18 @@ mod tests {
             let y = (bits >> 11) as f64 * 2f64.powi(scale - 53);
             for v in [y, -y, y.floor() + 0.5, -(y.floor() + 0.5)] {
                 prop_assert_eq!(super::round(v).to_bits(), v.round().to_bits(), "{}", v);
+            }
+        }
+
+        /// `positive_finite` is `x > 0.0 && x < f64::INFINITY`, for any bits and at
+        /// the edges (zeros, the smallest subnormal, the largest double, infinities,
+        /// NaN of either sign).
+        #[test]
+        fn positive_finite_matches_comparisons(bits in any::<u64>()) {
+            let edges = [0.0, -0.0, f64::from_bits(1), f64::MAX, f64::INFINITY,
+                f64::NEG_INFINITY, f64::NAN, -f64::NAN, -f64::from_bits(1), 1.0];
+            for x in edges.into_iter().chain([f64::from_bits(bits)]) {
+                prop_assert_eq!(super::positive_finite(x), x > 0.0 && x < f64::INFINITY, "{}", x);
             }
         }
     }

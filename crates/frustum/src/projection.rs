@@ -175,18 +175,16 @@ pub fn least_aligned_axis(dir: DVec3) -> DVec3 {
 /// arguments, so frames built from it are stable as the camera moves.
 #[must_use]
 pub fn light_rotation(dir: DVec3, up_hint: Vec3) -> DMat4 {
-    let up = if up_hint.is_finite() {
-        up_hint.as_dvec3().try_normalize()
-    } else {
-        None
-    };
-    if let Some(u) = up {
-        // `look_to`'s side axis is this cross product, normalized: computed once.
-        let side = dir.cross(u);
-        let length = side.length();
-        if length > 1e-3 {
-            return look_to_side(DVec3::ZERO, dir, side * (1.0 / length));
-        }
+    // `look_to`'s side axis is `dir × up` normalized, whatever the hint's length: it
+    // is taken from the hint as given, normalized once. The hint orients the frame
+    // where `|dir × up| > 1e-3 |up|` (the sine of their angle), compared squared; an
+    // `f32` hint's squares neither overflow nor vanish in `f64`, and a non-finite
+    // hint fails the first comparison.
+    let up = up_hint.as_dvec3();
+    let side = dir.cross(up);
+    let (side2, up2) = (side.length_squared(), up.length_squared());
+    if up2 < f64::INFINITY && side2 > 1e-6 * up2 {
+        return look_to_side(DVec3::ZERO, dir, side * (1.0 / math::sqrt(side2)));
     }
     look_to(DVec3::ZERO, dir, least_aligned_axis(dir))
 }

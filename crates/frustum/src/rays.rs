@@ -50,6 +50,30 @@ impl Rays {
         rays
     }
 
+    /// These rays mapped by the affine `m`, for the output axes `axes` only (the
+    /// others are left zero: read only those). Four rays at a time, axis by axis: a
+    /// frame change of the world-space rays without a product of matrices.
+    #[inline]
+    pub(crate) fn mapped(&self, m: &DMat4, axes: core::ops::Range<usize>) -> Self {
+        let mut rays = Self {
+            origin: [[0.0; 4]; 3],
+            dir: [[0.0; 4]; 3],
+        };
+        let (o, d) = (&self.origin, &self.dir);
+        for axis in axes {
+            let (x, y, z, w) = (
+                m.x_axis[axis],
+                m.y_axis[axis],
+                m.z_axis[axis],
+                m.w_axis[axis],
+            );
+            rays.origin[axis] =
+                core::array::from_fn(|i| w + (z * o[2][i] + (y * o[1][i] + x * o[0][i])));
+            rays.dir[axis] = core::array::from_fn(|i| z * d[2][i] + (y * d[1][i] + x * d[0][i]));
+        }
+        rays
+    }
+
     /// The smallest and largest coordinates of the eight corners at depths `n` and
     /// `f`. (The corners of a checked camera are finite: `min_num` and `max_num`
     /// stand in for the NaN-aware `min` and `max`.)
@@ -63,8 +87,8 @@ impl Rays {
     }
 
     /// The smallest and largest coordinate `axis` of the eight corners at depths `n`
-    /// and `f`.
-    #[inline]
+    /// and `f`. (Inline: a few vector operations, once per slice.)
+    #[inline(always)]
     pub(crate) fn range(&self, axis: usize, n: f64, f: f64) -> (f64, f64) {
         let (o, d) = (&self.origin[axis], &self.dir[axis]);
         let near: [f64; 4] = core::array::from_fn(|i| o[i] + d[i] * n);
