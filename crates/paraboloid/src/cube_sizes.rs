@@ -15,8 +15,8 @@
 //! with `k` the largest scale whose atlas fits the budget. The needs come from
 //! `shadowmap_frustum::predict_errors`: view rays stopped on the receivers' box, each
 //! face measured as a mapping of its own (its window only). The faces are packed into
-//! shelves (largest first, the atlas as wide as the largest face), and the budget pays
-//! for the whole atlas, gaps included.
+//! shelves (highest first, at the shelf width that gives the smallest atlas), and the
+//! budget pays for the whole atlas, gaps included: a gap costs every face texels.
 
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec3, DVec4, Mat4, Vec2};
@@ -168,40 +168,70 @@ pub(crate) fn area(atlas: [u32; 2]) -> u64 {
 }
 
 /// Shelf packing of the face maps: the highest first (ties: the wider, then face
-/// order), each shelf as high as its first map. Of two atlas widths, the widest map
-/// and the side of a square of the maps' total area (if wider), the one giving the
-/// smaller atlas. The maps' offsets in face order and the atlas size; `None` when
-/// the atlas would exceed the largest texture side.
+/// order), each shelf as high as its first map, at the shelf width whose atlas is
+/// the smallest (ties: the narrowest, so equal squares make a column). The maps'
+/// offsets in face order and the atlas size; `None` when the atlas would exceed the
+/// largest texture side.
+///
+/// Every width is tried that matters: in a fixed order the shelves change only
+/// where the width reaches the summed width of a run of consecutive maps, so the
+/// smallest width of each packing is such a sum (at least the widest map), and
+/// trying every such sum finds the smallest atlas of any width. Two widths only
+/// (the widest map, a square of the maps' area) leave gaps: maps of sides 84, 44,
+/// 44, 31, 21, 21 make an atlas 84 wide with a 40-texel gap beside one of the 44s
+/// (16,212 texels), where 88 packs both 44s on one shelf (13,992).
 pub(crate) fn pack(sizes: &[Size]) -> (ArrayVec<[u32; 2], 6>, Option<[u32; 2]>) {
     let sizes = sizes.get(..6).unwrap_or(sizes);
+    let order = shelf_order(sizes);
     let widest = sizes.iter().map(|s| s[0]).max().unwrap_or(0);
-    let total: u64 = sizes.iter().map(|s| area(*s)).sum();
-    let square = (math::ceil(math::sqrt(total as f64)) as u32).max(widest);
-    let narrow = pack_width(sizes, widest);
-    let wide = pack_width(sizes, square);
-    let size = |p: &(ArrayVec<[u32; 2], 6>, Option<[u32; 2]>)| p.1.map_or(u64::MAX, area);
-    if size(&wide) < size(&narrow) {
-        wide
-    } else {
-        narrow
+    // The sums of the runs of consecutive maps past the widest (21 at most).
+    let mut widths: ArrayVec<u32, 22> = ArrayVec::new();
+    widths.push(widest);
+    for start in 0..order.len() {
+        let mut width = 0u64;
+        for &i in &order[start..] {
+            width += u64::from(sizes[i][0]);
+            if let Ok(w) = u32::try_from(width) {
+                if w > widest && w <= MAX_SIDE {
+                    let _ = widths.try_push(w);
+                }
+            }
+        }
     }
+    widths
+        .iter()
+        .map(|&w| pack_width(sizes, &order, w))
+        .min_by_key(|p| p.1.map_or((u64::MAX, u32::MAX), |a| (area(a), a[0])))
+        .unwrap_or_else(|| pack_width(sizes, &order, widest))
 }
 
-/// [`pack`] into shelves of width `width` (at least the widest map).
-fn pack_width(sizes: &[Size], width: u32) -> (ArrayVec<[u32; 2], 6>, Option<[u32; 2]>) {
-    let mut order: ArrayVec<usize, 6> = (0..sizes.len()).collect();
+/// The order of the shelves: the highest map first (ties: the wider, then face
+/// order).
+fn shelf_order(sizes: &[Size]) -> ArrayVec<usize, 6> {
+    let mut order: ArrayVec<usize, 6> = (0..sizes.len().min(6)).collect();
     order.sort_by(|a, b| {
         let (sa, sb) = (sizes[*a], sizes[*b]);
         sb[1].cmp(&sa[1]).then(sb[0].cmp(&sa[0])).then(a.cmp(b))
     });
+    order
+}
+
+/// [`pack`] into shelves of width `width` (at least the widest map), the maps in
+/// `order`.
+fn pack_width(
+    sizes: &[Size],
+    order: &[usize],
+    width: u32,
+) -> (ArrayVec<[u32; 2], 6>, Option<[u32; 2]>) {
     let mut offsets: ArrayVec<[u32; 2], 6> = (0..order.len()).map(|_| [0, 0]).collect();
     let height = shelves(
-        &order,
+        order,
         |i| sizes[i].map(u64::from),
         u64::from(width),
         |i, at| offsets[i] = at,
     );
-    let atlas = (height <= u64::from(MAX_SIDE)).then_some([width, height as u32]);
+    let fits = height <= u64::from(MAX_SIDE) && width <= MAX_SIDE;
+    let atlas = fits.then_some([width, height as u32]);
     (offsets, atlas)
 }
 
@@ -419,6 +449,34 @@ mod tests {
             vec![[90, 30], [90, 90], [30, 30], [30, 90], [30, 30], [30, 30]],
         ] {
             check_packing(&sizes);
+        }
+    }
+
+    /// The atlas is the smallest of any shelf width: a face beside the largest
+    /// one's shelf, or two on one shelf, rather than a gap on every shelf of an
+    /// atlas as wide as the largest face (the sides of the faces of a seed-5 sweep
+    /// terrain: 84 wide, 16,212 texels; 88 wide, 13,992).
+    #[test]
+    fn the_atlas_is_the_smallest_of_any_shelf_width() {
+        let terrain = [[31, 31], [84, 84], [21, 21], [21, 21], [44, 44], [44, 44]];
+        let (_, atlas) = pack(&terrain);
+        assert_eq!(atlas, Some([88, 159]));
+        check_packing(&terrain);
+        for sizes in [
+            &terrain[..],
+            &[[83, 83], [20, 20], [20, 20], [20, 20], [26, 26], [65, 65]],
+            &[[10, 10], [200, 50], [7, 90], [199, 199], [64, 64], [64, 8]],
+            &[[90, 30], [90, 90], [30, 30], [30, 90], [30, 30], [30, 30]],
+            &[[5, 5]],
+        ] {
+            let best = area(pack(sizes).1.unwrap());
+            let order = shelf_order(sizes);
+            let widest = sizes.iter().map(|s| s[0]).max().unwrap();
+            let sum: u32 = sizes.iter().map(|s| s[0]).sum();
+            for width in widest..=sum {
+                let texels = area(pack_width(sizes, &order, width).1.unwrap());
+                assert!(best <= texels, "{sizes:?}: {best} > {texels} at {width}");
+            }
         }
     }
 

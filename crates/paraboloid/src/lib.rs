@@ -244,7 +244,8 @@
 //! receivers' box; `shadowmap::fit` measures it on the eye's samples when it has
 //! them, see [`CubeMap::set_sizes_by_need`]), so every face is predicted to reach the
 //! same error. The faces' maps are then tiles of one atlas ([`CubeMap::atlas`],
-//! shelves of tiles, the largest first), and its whole area is what the map costs
+//! shelves of tiles, the largest first, at the shelf width that gives the smallest
+//! atlas), and its whole area is what the map costs
 //! ([`CubeMap::texels`]); [`CubeMap::atlas_sample`] turns a face's sample into atlas
 //! coordinates.
 //!
