@@ -500,6 +500,34 @@ fn a_small_room_gets_fewer_cascades_than_open_ground() {
     assert_eq!(count(&camera, SceneBounds::whole(room), 2.0, 6.0), 1);
 }
 
+/// A sweep case of the quality report in the indoor room (10 x 3 x 8 m) at 128²
+/// texels: the camera at `eye` looking along `forward` (60° vertical field of view,
+/// 16:9), its depth range and the eye samples' depth bounds, the sun along
+/// `light`. The layers of each technique's fit.
+struct RoomCase {
+    eye: Vec3,
+    forward: Vec3,
+    range: (f32, f32),
+    bounds: (f32, f32),
+    light: Vec3,
+}
+
+impl RoomCase {
+    fn layers(&self, technique: &Technique) -> u32 {
+        let room = Aabb::new(Vec3::new(-5.0, 0.0, -4.0), Vec3::new(5.0, 3.0, 4.0));
+        let (near, far) = self.range;
+        let projection = Projection::perspective(60f32.to_radians(), 16.0 / 9.0, near, far);
+        let camera = Camera::look_to(self.eye, self.forward, Vec3::Y, projection).unwrap();
+        let light = Light::Directional {
+            direction: self.light,
+        };
+        let (min, max) = self.bounds;
+        let input = FitInput::new(&camera, &light, SceneBounds::whole(room), 128 * 128)
+            .with_depth_bounds(Some(DepthBounds { min, max }));
+        fit(technique, &input).unwrap().layers()
+    }
+}
+
 /// A sweep case of the quality report: a room, the camera looking 43° down, the light
 /// 10° off the view. Each slice's map then covers nearly the whole footprint, so four
 /// maps of a quarter of the budget give the far slices coarser texels than one map:
@@ -508,32 +536,18 @@ fn a_small_room_gets_fewer_cascades_than_open_ground() {
 /// 1.54x higher; the tail rule keeps one cascade.
 #[test]
 fn a_light_along_the_view_in_a_room_keeps_one_cascade() {
-    let room = Aabb::new(Vec3::new(-5.0, 0.0, -4.0), Vec3::new(5.0, 3.0, 4.0));
-    let camera = Camera::look_to(
-        Vec3::new(2.571_319_3, 1.0, 3.643_666_3),
-        Vec3::new(0.216_262_62, -0.681_482_14, -0.699_151_3),
-        Vec3::Y,
-        Projection::perspective(60f32.to_radians(), 16.0 / 9.0, 0.754_495_1, 15.783_536),
-    )
-    .unwrap();
-    let light = Light::Directional {
-        direction: Vec3::new(0.223_679_5, -0.773_996_2, -0.592_365_9),
+    let case = RoomCase {
+        eye: Vec3::new(2.571_319_3, 1.0, 3.643_666_3),
+        forward: Vec3::new(0.216_262_62, -0.681_482_14, -0.699_151_3),
+        range: (0.754_495_1, 15.783_536),
+        bounds: (0.915_524_24, 3.694_208_9),
+        light: Vec3::new(0.223_679_5, -0.773_996_2, -0.592_365_9),
     };
-    let bounds = DepthBounds {
-        min: 0.915_524_24,
-        max: 3.694_208_9,
-    };
-    let input = FitInput::new(&camera, &light, SceneBounds::whole(room), 128 * 128)
-        .with_depth_bounds(Some(bounds));
     for technique in [
         Technique::TightCascades(CascadePlan::default()),
         Technique::StableCascades(CascadePlan::default()),
     ] {
-        assert_eq!(
-            fit(&technique, &input).unwrap().layers(),
-            1,
-            "{technique:?}"
-        );
+        assert_eq!(case.layers(&technique), 1, "{technique:?}");
     }
 }
 
@@ -542,29 +556,24 @@ fn a_light_along_the_view_in_a_room_keeps_one_cascade() {
 /// cascades predict one map best, and one tight map is the uniform fit. One stable
 /// map, newly sized, takes its margins for the camera's turn and walk: over this
 /// footprint 8% and 14% on its sides, which measured 1.12x the uniform fit's
-/// 95th-percentile error. Four stable maps of a quarter of the texels each take
-/// their margins over slices the margins cost less than the split gains (1.01x):
-/// the stable cascades choose their count on their own predicted error.
+/// 95th-percentile error. Four stable maps of a quarter of the texels each cost
+/// less (1.01x): the stable cascades choose their count on their own predicted
+/// error.
 #[test]
 fn in_a_room_the_stable_cascades_choose_their_count_on_their_own_error() {
-    let room = Aabb::new(Vec3::new(-5.0, 0.0, -4.0), Vec3::new(5.0, 3.0, 4.0));
-    let camera = Camera::look_to(
-        Vec3::new(-4.550_791_7, 1.0, 1.037_736_5),
-        Vec3::new(0.081_558_75, -0.700_386_6, 0.709_088_7),
-        Vec3::Y,
-        Projection::perspective(60f32.to_radians(), 16.0 / 9.0, 0.503_045_8, 15.783_536),
-    )
-    .unwrap();
-    let light = Light::Directional {
-        direction: Vec3::new(0.180_986_85, -0.822_822, -0.538_709_34),
+    let case = RoomCase {
+        eye: Vec3::new(-4.550_791_7, 1.0, 1.037_736_5),
+        forward: Vec3::new(0.081_558_75, -0.700_386_6, 0.709_088_7),
+        range: (0.503_045_8, 15.783_536),
+        bounds: (0.503_220_9, 3.079_653_7),
+        light: Vec3::new(0.180_986_85, -0.822_822, -0.538_709_34),
     };
-    let bounds = DepthBounds {
-        min: 0.503_220_9,
-        max: 3.079_653_7,
-    };
-    let input = FitInput::new(&camera, &light, SceneBounds::whole(room), 128 * 128)
-        .with_depth_bounds(Some(bounds));
-    let layers = |technique| fit(&technique, &input).unwrap().layers();
-    assert_eq!(layers(Technique::TightCascades(CascadePlan::default())), 1);
-    assert_eq!(layers(Technique::StableCascades(CascadePlan::default())), 4);
+    assert_eq!(
+        case.layers(&Technique::TightCascades(CascadePlan::default())),
+        1
+    );
+    assert_eq!(
+        case.layers(&Technique::StableCascades(CascadePlan::default())),
+        4
+    );
 }

@@ -17,42 +17,18 @@ pub(crate) struct Rays {
 impl Rays {
     /// The view-space rays `origin[i] + d * dir[i]` mapped by the affine `m`.
     pub(crate) fn new(m: &DMat4, origin: &[DVec3; 4], dir: &[DVec3; 4]) -> Self {
-        Self::axes(m, origin, dir, 0..3)
-    }
-
-    /// [`Rays::new`] for the output axes `axes` only (the others are left zero: read
-    /// only those).
-    pub(crate) fn axes(
-        m: &DMat4,
-        origin: &[DVec3; 4],
-        dir: &[DVec3; 4],
-        axes: core::ops::Range<usize>,
-    ) -> Self {
-        // `transform_point3` and `transform_vector3` one output axis at a time, with
-        // their order of operations.
-        let mut rays = Self {
-            origin: [[0.0; 4]; 3],
-            dir: [[0.0; 4]; 3],
-        };
-        for axis in axes {
-            let (x, y, z, w) = (
-                m.x_axis[axis],
-                m.y_axis[axis],
-                m.z_axis[axis],
-                m.w_axis[axis],
-            );
-            for i in 0..4 {
-                let (o, d) = (origin[i], dir[i]);
-                rays.origin[axis][i] = w + (z * o.z + (y * o.y + x * o.x));
-                rays.dir[axis][i] = z * d.z + (y * d.y + x * d.x);
-            }
+        let by_axis = |v: &[DVec3; 4]| [0, 1, 2].map(|axis| v.map(|p| p[axis]));
+        Self {
+            origin: by_axis(origin),
+            dir: by_axis(dir),
         }
-        rays
+        .mapped(m, 0..3)
     }
 
     /// These rays mapped by the affine `m`, for the output axes `axes` only (the
-    /// others are left zero: read only those). Four rays at a time, axis by axis: a
-    /// frame change of the world-space rays without a product of matrices.
+    /// others are left zero: read only those). Four rays at a time, axis by axis, in
+    /// the order of operations of `transform_point3` and `transform_vector3`: a frame
+    /// change of the world-space rays without a product of matrices.
     #[inline]
     pub(crate) fn mapped(&self, m: &DMat4, axes: core::ops::Range<usize>) -> Self {
         let mut rays = Self {
