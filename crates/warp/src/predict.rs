@@ -197,7 +197,7 @@ impl Probe {
         let confidence = self.confidence();
         let mut clips: [Option<Option<DMat4>>; GRID] = [None; GRID];
         let mut clip = |t: f64| {
-            let i = ((t * (GRID - 1) as f64).round() as usize).min(GRID - 1);
+            let i = (math::round(t * (GRID - 1) as f64) as usize).min(GRID - 1);
             *clips[i].get_or_insert_with(|| clip_at(t))
         };
         let lit = (confidence > 0.0)
