@@ -1,8 +1,10 @@
 //! Per-frame cost of the umbrella's stateful fits of a directional light
-//! (`shadowmap::fit_with_state`): the stable, tight and warped cascades with their
-//! count chosen from the predicted error, and `auto`, which fits all seven
-//! candidates and predicts their error (or, given the eye samples of a 160 x 90
-//! G-buffer, measures it on them); each beside the uniform fit timed in the same run. Besides
+//! (`shadowmap::fit_with_state`): LiSPSM with and without the eye samples (which it
+//! measures its strength on), the stable, tight and warped cascades with their
+//! count chosen from the predicted error (the tight and stable ones also given the
+//! eye samples of a 160 x 90 G-buffer, which they measure each count on), and
+//! `auto`, which fits all seven candidates and predicts their error (or, given the
+//! samples, measures it on them); each beside the uniform fit timed in the same run. Besides
 //! criterion's figures it prints each fit's time per call (the fastest of many short
 //! batches, see `support/timing.rs`) and its ratio to the uniform fit. `FIT_STATE_ONLY`
 //! runs one fit for instruction counting (see `only`).
@@ -109,6 +111,18 @@ fn fits(c: &mut Criterion) {
         ("stable_cascades", Technique::StableCascades(plan), &input),
         ("warped_cascades", warped, &input),
         ("auto", Technique::Auto(plan), &input),
+        ("lispsm", Technique::Lispsm(Default::default()), &input),
+        (
+            "lispsm_on_samples",
+            Technique::Lispsm(Default::default()),
+            &sampled,
+        ),
+        ("tight_on_samples", Technique::TightCascades(plan), &sampled),
+        (
+            "stable_on_samples",
+            Technique::StableCascades(plan),
+            &sampled,
+        ),
         ("auto_on_samples", Technique::Auto(plan), &sampled),
     ];
     if only(&techniques) {

@@ -146,52 +146,10 @@ fn predict(
 mod tests {
     use glam::Vec3;
     use shadowmap_frustum::{Aabb, Camera, Projection, SceneBounds};
-    use shadowmap_rtw::EyeSample;
 
     use super::*;
     use crate::fit::{depth_bounds_of, fit};
-
-    /// Where a grid of the camera's rays meets the ground plane `y = 0`, and a wall
-    /// `z = wall` facing `+z` above it (the end of a street).
-    fn street_samples(camera: &Camera, columns: usize, rows: usize, wall: f32) -> Vec<EyeSample> {
-        let c = camera.frustum().unwrap().corners;
-        let eye = camera.eye();
-        let mut out = Vec::new();
-        for row in 0..rows {
-            for column in 0..columns {
-                let (x, y) = (
-                    (column as f32 + 0.5) / columns as f32,
-                    (row as f32 + 0.5) / rows as f32,
-                );
-                let near = c[0].lerp(c[1], x).lerp(c[3].lerp(c[2], x), y);
-                let d = (near - eye).normalize();
-                let t_ground = if d.y < -1e-3 {
-                    -eye.y / d.y
-                } else {
-                    f32::INFINITY
-                };
-                let t_wall = if d.z < -1e-3 {
-                    (wall - eye.z) / d.z
-                } else {
-                    f32::INFINITY
-                };
-                let (t, normal) = if t_ground < t_wall {
-                    (t_ground, Vec3::Y)
-                } else {
-                    (t_wall, Vec3::Z)
-                };
-                if t.is_finite() && (eye + d * t).y < 12.0 {
-                    let position = eye + d * t;
-                    out.push(EyeSample {
-                        position,
-                        normal,
-                        eye_distance: t,
-                    });
-                }
-            }
-        }
-        out
-    }
+    use crate::test_views::street_samples;
 
     /// With the eye samples, `auto` keeps the candidate whose aliasing error on
     /// them is the lowest, each candidate measured as the quality report measures

@@ -12,12 +12,13 @@ use shadowmap_frustum::{
 };
 use shadowmap_paraboloid::{ParaboloidError, ParaboloidMap};
 use shadowmap_rtw::{EyeSample, ImportanceMap, OracleAxis, RtwError, WarpMaps};
-use shadowmap_warp::{WarpError, lispsm, spot_warp, tsm, uniform_focused, xpsm};
+use shadowmap_warp::{WarpError, spot_warp, uniform_focused};
 
 use crate::cascaded::{CountChoice, fit_cascades, fit_warped};
 use crate::point_fit;
 use crate::shadow::{Fitted, Shadow};
 use crate::technique::{DpsmOptions, RtwPlan, Technique};
+use crate::warp_fit::fit_warp;
 
 /// What a technique may look at in one frame: the same for every technique.
 ///
@@ -302,9 +303,9 @@ fn fit_one(
             Fitted::Uniform(uniform_focused(camera, direction, scene, o)?),
             1,
         ),
-        Technique::Lispsm(o) => (Fitted::Lispsm(lispsm(camera, direction, scene, o)?), 1),
-        Technique::Xpsm(o) => (Fitted::Xpsm(xpsm(camera, direction, scene, o)?), 1),
-        Technique::Tsm(o) => (Fitted::Tsm(tsm(camera, direction, scene, o)?), 1),
+        Technique::Lispsm(_) | Technique::Xpsm(_) | Technique::Tsm(_) => {
+            (fit_warp(technique, direction, input)?, 1)
+        }
         Technique::StableCascades(plan) | Technique::TightCascades(plan) => {
             let stable = matches!(technique, Technique::StableCascades(_));
             fit_cascades(plan, stable, direction, input, &mut state.cascades, count)?
@@ -492,13 +493,16 @@ fn fit_rtw(
 pub(crate) fn front_lit(samples: &[EyeSample], light: LightDirection) -> Vec<EyeSample> {
     samples
         .iter()
-        .filter(|s| {
-            s.normal.try_normalize().is_none_or(|n| {
-                n.as_dvec3().dot(light.toward(s.position.as_dvec3())) >= FRONT_LIT_MIN_COS
-            })
-        })
+        .filter(|s| is_front_lit(s, light))
         .copied()
         .collect()
+}
+
+/// Whether [`front_lit`] keeps `sample`.
+pub(crate) fn is_front_lit(sample: &EyeSample, light: LightDirection) -> bool {
+    sample.normal.try_normalize().is_none_or(|n| {
+        n.as_dvec3().dot(light.toward(sample.position.as_dvec3())) >= FRONT_LIT_MIN_COS
+    })
 }
 
 fn fit_dpsm(options: &DpsmOptions, light: &Light) -> Result<ParaboloidMap, FitError> {

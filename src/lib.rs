@@ -154,6 +154,8 @@ mod shadow;
 mod technique;
 #[cfg(all(test, feature = "warp", feature = "paraboloid", feature = "rtw"))]
 mod test_views;
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod warp_fit;
 
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 pub use auto::{AUTO_CANDIDATE_COUNT, AUTO_MAX_SAMPLES, auto_candidates};

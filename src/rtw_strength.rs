@@ -1,7 +1,7 @@
 //! The strength of RTW's warp over its base (a directional light's uniform fit, a
 //! spot light's perspective fit), measured at the eye samples it was built from.
 
-use shadowmap_frustum::{Camera, LightDirection, ShadowTransform};
+use shadowmap_frustum::{Camera, LightDirection, ShadowMapping, ShadowTransform};
 use shadowmap_rtw::{EyeSample, ImportanceMap, RtwShadow, WarpMaps, WarpOptions};
 
 use crate::fit::FitError;
@@ -41,23 +41,50 @@ pub(crate) fn build_measured(
     options: &WarpOptions,
     warps: &mut WarpMaps,
 ) -> Result<(), FitError> {
-    let measure = |mapping: &RtwShadow<'_>| {
-        sample_error(
-            mapping,
-            1.0,
-            &Samples::new(camera, PIXELS_PER_RADIAN, samples),
-            light,
-            0.95,
-        )
-        .unwrap_or(f64::INFINITY)
+    let measure = |warps: &WarpMaps| {
+        let mapping = RtwShadow { base: *base, warps };
+        warped_error(&mapping, samples, camera, light)
     };
+    build_measured_by(importance, options, warps, measure)
+}
+
+/// The measure [`build_measured`] ranks strengths by: the 95th percentile of `m`
+/// over the samples `mapping` covers, infinite where it covers none.
+pub(crate) fn warped_error(
+    mapping: &dyn ShadowMapping,
+    samples: &[EyeSample],
+    camera: &Camera,
+    light: LightDirection,
+) -> f64 {
+    sample_error(
+        mapping,
+        1.0,
+        &Samples::new(camera, PIXELS_PER_RADIAN, samples),
+        light,
+        0.95,
+    )
+    .unwrap_or(f64::INFINITY)
+}
+
+/// Builds `warps` from `importance` raised to the strength in [`STRENGTHS`] whose
+/// warps `measure` finds the least error (the strongest on ties; the full warp
+/// where no strength measures finite): [`build_measured`] over any base, a
+/// paraboloid side's included.
+///
+/// # Errors
+/// The warp builder's errors.
+pub(crate) fn build_measured_by(
+    importance: &ImportanceMap,
+    options: &WarpOptions,
+    warps: &mut WarpMaps,
+    measure: impl Fn(&WarpMaps) -> f64,
+) -> Result<(), FitError> {
     let mut raised = ImportanceMap::new(importance.width(), importance.height())?;
     let mut best: Option<(f64, f32)> = None;
     for t in STRENGTHS {
         raise(importance, t, &mut raised)?;
         warps.build(&raised, options)?;
-        let mapping = RtwShadow { base: *base, warps };
-        let error = measure(&mapping);
+        let error = measure(warps);
         if best.is_none_or(|(e, _)| error <= e) {
             best = Some((error, t));
         }

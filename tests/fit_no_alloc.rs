@@ -1,5 +1,6 @@
 //! `fit` allocates nothing per frame for every technique but RTW (its importance map
-//! and tables), `auto` included, and IPSM and cube maps measured on eye samples,
+//! and tables), `auto` included, and IPSM, cube maps, warps, cascades and `auto`
+//! measured on eye samples,
 //! under a counting global allocator (one test in this binary, so nothing else
 //! allocates meanwhile).
 
@@ -9,7 +10,7 @@ use glam::Vec3;
 use shadowmap::frustum::{Aabb, Camera, Light, Projection, SceneBounds, TechniqueSelector};
 use shadowmap::paraboloid::{CubeOptions, FaceSizes, IpsmOptions};
 use shadowmap::rtw::EyeSample;
-use shadowmap::{FitInput, Technique, fit_with_selector};
+use shadowmap::{CascadePlan, FitInput, Technique, fit_with_selector};
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
 
 #[global_allocator]
@@ -49,7 +50,8 @@ fn fit_does_not_allocate() {
     // Every technique but the two RTW ones.
     assert_eq!(techniques.len(), Technique::all_default().len() - 2);
     let mut selector = TechniqueSelector::new();
-    // With the eye's samples, IPSM and cube maps sized by need measure on them.
+    // With the eye's samples, IPSM, cube maps sized by need, the warps' strength, the
+    // cascades' count and `auto` measure on them.
     let samples: Vec<EyeSample> = (0..2000)
         .map(|k| {
             let p = Vec3::new(
@@ -64,9 +66,19 @@ fn fit_does_not_allocate() {
             }
         })
         .collect();
+    let plan = CascadePlan::default();
     let measured = [
-        Technique::Ipsm(IpsmOptions::default()),
-        Technique::CubeMaps(CubeOptions::default().with_sizes(FaceSizes::ByNeed)),
+        (Technique::Ipsm(IpsmOptions::default()), &lamp),
+        (
+            Technique::CubeMaps(CubeOptions::default().with_sizes(FaceSizes::ByNeed)),
+            &lamp,
+        ),
+        (Technique::Lispsm(Default::default()), &sun),
+        (Technique::Xpsm(Default::default()), &sun),
+        (Technique::Tsm(Default::default()), &sun),
+        (Technique::TightCascades(plan), &sun),
+        (Technique::StableCascades(plan), &sun),
+        (Technique::Auto(plan), &sun),
     ];
 
     // Counted around each call only: the test harness's own threads may allocate
@@ -101,8 +113,8 @@ fn fit_does_not_allocate() {
             fitted += counted(technique, &input);
         }
     }
-    for technique in &measured {
-        let input = FitInput::new(&camera, &lamp, scene, 2048 * 2048)
+    for (technique, light) in &measured {
+        let input = FitInput::new(&camera, light, scene, 2048 * 2048)
             .with_eye_samples(&samples)
             .with_pixels_per_radian(500.0);
         fitted += counted(technique, &input);

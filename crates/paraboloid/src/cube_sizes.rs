@@ -12,7 +12,10 @@
 //! side_f = k * max(need_f, MIN_SIDE_RATIO * max_g need_g)
 //! ```
 //!
-//! with `k` the largest scale whose atlas fits the budget. The needs come from
+//! with `k` the largest scale whose atlas fits the budget
+//! ([`CubeMap::set_sizes_by_need_with_floor`] takes another floor than
+//! [`MIN_SIDE_RATIO`], for needs measured on the surfaces the eye sees). The needs
+//! come from
 //! `shadowmap_frustum::predict_errors`: view rays stopped on the receivers' box, each
 //! face measured as a mapping of its own (its window only). The faces are packed into
 //! shelves (highest first, at the shelf width that gives the smallest atlas), and the
@@ -117,9 +120,14 @@ pub(crate) fn equal_sizes(count: usize, budget: u64) -> ArrayVec<Size, 6> {
 /// a face without a need gets the smallest one allowed), at the largest scale whose
 /// atlas fits `budget` (at least [`MIN_SIDE`] per axis).
 ///
-/// A face's larger need is at least [`MIN_SIDE_RATIO`] times the largest of all
-/// faces, and its smaller one at least [`MIN_ASPECT`] times its larger one.
-pub(crate) fn sizes_by_need(needs: &[Option<[f64; 2]>], budget: u64) -> ArrayVec<Size, 6> {
+/// A face's larger need is at least `min_side_ratio` (clamped to `[0, 1]`) times
+/// the largest of all faces, and its smaller one at least [`MIN_ASPECT`] times its
+/// larger one.
+pub(crate) fn sizes_by_need(
+    needs: &[Option<[f64; 2]>],
+    budget: u64,
+    min_side_ratio: f64,
+) -> ArrayVec<Size, 6> {
     let valid = |n: &[f64; 2]| n.iter().all(|x| x.is_finite() && *x > 0.0);
     let top = needs
         .iter()
@@ -130,7 +138,7 @@ pub(crate) fn sizes_by_need(needs: &[Option<[f64; 2]>], budget: u64) -> ArrayVec
     if !(top > 0.0 && top.is_finite()) {
         return equal_sizes(needs.len(), budget);
     }
-    let floor = top * MIN_SIDE_RATIO;
+    let floor = top * min_side_ratio.clamp(0.0, 1.0);
     let weights: ArrayVec<[f64; 2], 6> = needs
         .iter()
         .take(6)
@@ -159,7 +167,49 @@ pub(crate) fn sizes_by_need(needs: &[Option<[f64; 2]>], budget: u64) -> ArrayVec
             hi = mid;
         }
     }
-    sizes_at(lo)
+    grown_into_gaps(sizes_at(lo), &weights, budget)
+}
+
+/// Most single-texel steps [`grown_into_gaps`] takes.
+const GROWTH_STEPS: usize = 32;
+
+/// `sizes` (scaled together from `weights` to the largest scale that fits) grown
+/// one texel at a time into what the packing leaves: the axis of the largest
+/// error (weight over side) of the face of the largest grows while the atlas stays
+/// within `budget`, for at most [`GROWTH_STEPS`] steps. Four squares of needs 599, 463, 385 and 345 packed
+/// into 135 x 120 texels leave 16% of it empty; grown, the face of the largest
+/// need takes part of that.
+fn grown_into_gaps(
+    mut sizes: ArrayVec<Size, 6>,
+    weights: &[[f64; 2]],
+    budget: u64,
+) -> ArrayVec<Size, 6> {
+    let error = |size: Size, w: &[f64; 2], axis: usize| w[axis] / f64::from(size[axis].max(1));
+    let mut stuck = [false; 6];
+    for _ in 0..GROWTH_STEPS {
+        let mut worst: Option<(f64, usize)> = None;
+        for (f, (size, w)) in sizes.iter().zip(weights).enumerate() {
+            let e = error(*size, w, 0).max(error(*size, w, 1));
+            if !stuck[f] && worst.is_none_or(|(largest, _)| e > largest) {
+                worst = Some((e, f));
+            }
+        }
+        let Some((e, f)) = worst else { break };
+        // Every axis at the face's error grows: both sides of a square of equal
+        // needs (one side alone would not lower its error).
+        let mut grown = sizes.clone();
+        for axis in 0..2 {
+            if error(sizes[f], &weights[f], axis) >= e * (1.0 - 1e-9) {
+                grown[f][axis] = (grown[f][axis] + 1).min(MAX_SIDE);
+            }
+        }
+        if pack(&grown).1.is_some_and(|a| area(a) <= budget) {
+            sizes = grown;
+        } else {
+            stuck[f] = true;
+        }
+    }
+    sizes
 }
 
 /// Texels of an atlas.
@@ -167,16 +217,18 @@ pub(crate) fn area(atlas: [u32; 2]) -> u64 {
     u64::from(atlas[0]) * u64::from(atlas[1])
 }
 
-/// Shelf packing of the face maps: the highest first (ties: the wider, then face
-/// order), each shelf as high as its first map, at the shelf width whose atlas is
-/// the smallest (ties: the narrowest, so equal squares make a column). The maps'
+/// Packing of the face maps, the highest first (ties: the wider, then face order):
+/// on shelves, each as high as its first map, or on a skyline
+/// ([`pack_skyline`]), at the width and by the packing whose atlas is the smallest
+/// (ties: the narrowest, so equal squares make a column; then the shelves). The maps'
 /// offsets in face order and the atlas size; `None` when the atlas would exceed the
 /// largest texture side.
 ///
 /// Every width is tried that matters: in a fixed order the shelves change only
 /// where the width reaches the summed width of a run of consecutive maps, so the
 /// smallest width of each packing is such a sum (at least the widest map), and
-/// trying every such sum finds the smallest atlas of any width. Two widths only
+/// trying every such sum finds the smallest shelf atlas of any width (the skyline
+/// is tried at the same widths). Two widths only
 /// (the widest map, a square of the maps' area) leave gaps: maps of sides 84, 44,
 /// 44, 31, 21, 21 make an atlas 84 wide with a 40-texel gap beside one of the 44s
 /// (16,212 texels), where 88 packs both 44s on one shelf (13,992).
@@ -200,9 +252,94 @@ pub(crate) fn pack(sizes: &[Size]) -> (ArrayVec<[u32; 2], 6>, Option<[u32; 2]>) 
     }
     widths
         .iter()
-        .map(|&w| pack_width(sizes, &order, w))
+        .flat_map(|&w| [pack_width(sizes, &order, w), pack_skyline(sizes, &order, w)])
         .min_by_key(|p| p.1.map_or((u64::MAX, u32::MAX), |a| (area(a), a[0])))
         .unwrap_or_else(|| pack_width(sizes, &order, widest))
+}
+
+/// Skyline packing of the maps in `order` into an atlas `width` texels wide: each
+/// map at the lowest place on the outline of those before it (the leftmost of the
+/// lowest), at the start of one of the outline's segments. Where a shelf is as high
+/// as its first map and leaves a gap under the lower maps beside it, the skyline
+/// puts a later map into that gap: maps of sides 75, 58, 48 and 43 pack into 133 x
+/// 118 texels, where the best shelves take 133 x 123.
+fn pack_skyline(
+    sizes: &[Size],
+    order: &[usize],
+    width: u32,
+) -> (ArrayVec<[u32; 2], 6>, Option<[u32; 2]>) {
+    let width = u64::from(width);
+    let mut offsets: ArrayVec<[u32; 2], 6> = (0..order.len()).map(|_| [0, 0]).collect();
+    // The outline: segments (start, top) by increasing start, covering [0, width).
+    let mut outline: ArrayVec<(u64, u64), 16> = ArrayVec::new();
+    outline.push((0, 0));
+    for &i in order {
+        let [w, h] = sizes[i].map(u64::from);
+        let mut lowest: Option<(u64, u64)> = None;
+        for (k, &(x, _)) in outline.iter().enumerate() {
+            if x + w > width {
+                break;
+            }
+            let y = outline[k..]
+                .iter()
+                .take_while(|segment| segment.0 < x + w)
+                .map(|segment| segment.1)
+                .max()
+                .unwrap_or(0);
+            if lowest.is_none_or(|best| (y, x) < best) {
+                lowest = Some((y, x));
+            }
+        }
+        let Some((y, x)) = lowest else {
+            return (offsets, None);
+        };
+        if let (Some(at), Ok(ox), Ok(oy)) = (offsets.get_mut(i), u32::try_from(x), u32::try_from(y))
+        {
+            *at = [ox, oy];
+        }
+        outline = raised(&outline, width, (x, x + w), y + h);
+    }
+    let height = outline.iter().map(|segment| segment.1).max().unwrap_or(0);
+    let fits = height <= u64::from(MAX_SIDE) && width <= u64::from(MAX_SIDE);
+    let atlas = fits.then_some([width as u32, height as u32]);
+    (offsets, atlas)
+}
+
+/// The skyline `outline` (segments `(start, top)` over `[0, width)`) with `span`
+/// raised to `top`.
+fn raised(
+    outline: &[(u64, u64)],
+    width: u64,
+    span: (u64, u64),
+    top: u64,
+) -> ArrayVec<(u64, u64), 16> {
+    let mut next: ArrayVec<(u64, u64), 16> = ArrayVec::new();
+    let mut placed = false;
+    for (k, &(start, old)) in outline.iter().enumerate() {
+        let end = outline.get(k + 1).map_or(width, |segment| segment.0);
+        if end <= span.0 || start >= span.1 {
+            if start >= span.1 && !placed {
+                let _ = next.try_push((span.0, top));
+                placed = true;
+            }
+            let _ = next.try_push((start, old));
+            continue;
+        }
+        if start < span.0 {
+            let _ = next.try_push((start, old));
+        }
+        if !placed {
+            let _ = next.try_push((span.0, top));
+            placed = true;
+        }
+        if end > span.1 {
+            let _ = next.try_push((span.1, old));
+        }
+    }
+    if !placed {
+        let _ = next.try_push((span.0, top));
+    }
+    next
 }
 
 /// The order of the shelves: the highest map first (ties: the wider, then face
@@ -278,7 +415,7 @@ impl CubeMap {
                         .into_iter()
                         .map(|n| n.map(|n| [n, n]))
                         .collect();
-                sizes_by_need(&needs, budget)
+                sizes_by_need(&needs, budget, MIN_SIDE_RATIO)
             }
         };
         self.set_sizes(&sizes);
@@ -290,7 +427,47 @@ impl CubeMap {
     /// [`FaceSizes::ByNeed`] does, and packs the atlas. For a renderer with a better
     /// estimate of the needs than the receivers' box (RTW's importance, say).
     pub fn set_sizes_by_need(&mut self, needs: &[Option<[f64; 2]>], budget: u64) {
-        let sizes = sizes_by_need(needs, budget);
+        self.set_sizes_by_need_with_floor(needs, budget, MIN_SIDE_RATIO);
+    }
+
+    /// As [`set_sizes_by_need`](Self::set_sizes_by_need), with no face's side below
+    /// `min_side_ratio` (clamped to `[0, 1]`) times the largest face's instead of
+    /// [`MIN_SIDE_RATIO`]. That floor insures a face against a misjudged need;
+    /// needs measured on the surfaces the eye sees can take a lower one, so that a
+    /// face few pixels see does not keep a sixteenth of the largest face's texels.
+    ///
+    /// ```
+    /// use glam::Vec3;
+    /// use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds};
+    /// use shadowmap_paraboloid::{CubeMap, CubeOptions, MIN_SIDE_RATIO};
+    ///
+    /// // A lamp in the middle of a room seen from one corner: every face is kept.
+    /// let camera = Camera::look_to(
+    ///     Vec3::new(-4.0, 1.5, 4.0),
+    ///     Vec3::new(1.0, -0.2, -1.0),
+    ///     Vec3::Y,
+    ///     Projection::perspective(70f32.to_radians(), 1.5, 0.1, 30.0),
+    /// )?;
+    /// let light = Light::Point { position: Vec3::new(0.0, 1.5, 0.0), range: 20.0 };
+    /// let room = Aabb::new(Vec3::new(-5.0, 0.0, -5.0), Vec3::new(5.0, 3.0, 5.0));
+    /// let mut cube = CubeMap::fit(&light, &camera, None, &SceneBounds::new(room, room), &CubeOptions::default())?;
+    /// // One face needs twenty times the others' density.
+    /// let mut needs = vec![Some([1.0, 1.0]); cube.faces.len()];
+    /// needs[0] = Some([20.0, 20.0]);
+    /// cube.set_sizes_by_need(&needs, 1 << 16);
+    /// let floored = cube.faces[1].size[0];
+    /// assert!(floored as f64 >= 0.9 * MIN_SIDE_RATIO * cube.faces[0].size[0] as f64);
+    /// cube.set_sizes_by_need_with_floor(&needs, 1 << 16, 0.0);
+    /// assert!(cube.faces[1].size[0] < floored && cube.texels() <= 1 << 16);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn set_sizes_by_need_with_floor(
+        &mut self,
+        needs: &[Option<[f64; 2]>],
+        budget: u64,
+        min_side_ratio: f64,
+    ) {
+        let sizes = sizes_by_need(needs, budget, min_side_ratio);
         self.set_sizes(&sizes);
     }
 
@@ -424,7 +601,11 @@ mod tests {
     /// Maps do not overlap and lie in the atlas.
     fn check_packing(sizes: &[Size]) {
         let (offsets, atlas) = pack(sizes);
-        let atlas = atlas.unwrap();
+        check_apart(sizes, &offsets, atlas.unwrap());
+    }
+
+    /// Every map of `sizes` at `offsets` lies inside `atlas`, apart from the others.
+    fn check_apart(sizes: &[Size], offsets: &[[u32; 2]], atlas: [u32; 2]) {
         for (i, (a, sa)) in offsets.iter().zip(sizes).enumerate() {
             assert!(
                 a[0] + sa[0] <= atlas[0] && a[1] + sa[1] <= atlas[1],
@@ -456,19 +637,20 @@ mod tests {
     /// one's shelf, or two on one shelf, rather than a gap on every shelf of an
     /// atlas as wide as the largest face (the sides of the faces of a seed-5 sweep
     /// terrain: 84 wide, 16,212 texels; 88 wide, 13,992).
+    /// Face sizes of mixed shapes the packing tests share.
+    const MIXED: [&[Size]; 3] = [
+        &[[83, 83], [20, 20], [20, 20], [20, 20], [26, 26], [65, 65]],
+        &[[10, 10], [200, 50], [7, 90], [199, 199], [64, 64], [64, 8]],
+        &[[90, 30], [90, 90], [30, 30], [30, 90], [30, 30], [30, 30]],
+    ];
+
     #[test]
     fn the_atlas_is_the_smallest_of_any_shelf_width() {
         let terrain = [[31, 31], [84, 84], [21, 21], [21, 21], [44, 44], [44, 44]];
         let (_, atlas) = pack(&terrain);
         assert_eq!(atlas, Some([88, 159]));
         check_packing(&terrain);
-        for sizes in [
-            &terrain[..],
-            &[[83, 83], [20, 20], [20, 20], [20, 20], [26, 26], [65, 65]],
-            &[[10, 10], [200, 50], [7, 90], [199, 199], [64, 64], [64, 8]],
-            &[[90, 30], [90, 90], [30, 30], [30, 90], [30, 30], [30, 30]],
-            &[[5, 5]],
-        ] {
+        for sizes in [&terrain[..], &[[5, 5]]].into_iter().chain(MIXED) {
             let best = area(pack(sizes).1.unwrap());
             let order = shelf_order(sizes);
             let widest = sizes.iter().map(|s| s[0]).max().unwrap();
@@ -476,6 +658,31 @@ mod tests {
             for width in widest..=sum {
                 let texels = area(pack_width(sizes, &order, width).1.unwrap());
                 assert!(best <= texels, "{sizes:?}: {best} > {texels} at {width}");
+            }
+        }
+    }
+
+    /// The skyline fills the gap a shelf leaves under its lower maps, and holds
+    /// every map apart inside the atlas.
+    #[test]
+    fn the_skyline_fills_the_gaps_of_the_shelves() {
+        let city = [[75, 75], [58, 58], [4, 4], [4, 4], [43, 43], [48, 48]];
+        let order = shelf_order(&city);
+        let shelves = (75..=232)
+            .filter_map(|w| pack_width(&city, &order, w).1)
+            .map(area)
+            .min()
+            .unwrap();
+        assert_eq!(shelves, 133 * 123);
+        let (_, atlas) = pack(&city);
+        assert!(area(atlas.unwrap()) <= 133 * 118, "{atlas:?}");
+        check_packing(&city);
+        for sizes in [&city[..]].into_iter().chain(MIXED) {
+            let order = shelf_order(sizes);
+            for width in [200, 250, 300, 400] {
+                if let (offsets, Some(atlas)) = pack_skyline(sizes, &order, width) {
+                    check_apart(sizes, &offsets, atlas);
+                }
             }
         }
     }
@@ -491,28 +698,34 @@ mod tests {
             Some([1.0, 1.0]),
             Some([0.01, 0.01]),
         ];
-        let sizes = sizes_by_need(&needs, budget);
+        let sizes = sizes_by_need(&needs, budget, MIN_SIDE_RATIO);
         let (_, atlas) = pack(&sizes);
         let texels = area(atlas.unwrap());
         assert!(texels <= budget && texels > budget * 8 / 10, "{texels}");
         // Three times the need, three times the side (up to rounding); twice the
         // need along u, twice the width; the face without a need and the one below
-        // the floor get the floor.
+        // the floor get at least the floor (and what the packing leaves, grown
+        // into: less than the faces with a need).
         assert!((f64::from(sizes[0][0]) / f64::from(sizes[1][0]) - 3.0).abs() < 0.05);
         assert!((f64::from(sizes[2][0]) / f64::from(sizes[2][1]) - 2.0).abs() < 0.05);
         let floor = (f64::from(sizes[0][0]) * MIN_SIDE_RATIO) as u32;
-        assert!(sizes[3][0].abs_diff(floor) <= 1 && sizes[5][1].abs_diff(floor) <= 1);
+        for small in [sizes[3][0], sizes[5][1]] {
+            assert!(small + 1 >= floor && small < sizes[1][0], "{sizes:?}");
+        }
         check_packing(&sizes);
         // An extreme aspect is limited.
-        let thin = sizes_by_need(&[Some([1.0, 1e-4])], budget);
+        let thin = sizes_by_need(&[Some([1.0, 1e-4])], budget, MIN_SIDE_RATIO);
         assert!((f64::from(thin[0][1]) / f64::from(thin[0][0]) - MIN_ASPECT).abs() < 0.01);
         // Equal needs: equal squares, as `equal_sizes` (up to the last texel).
-        let same = sizes_by_need(&[Some([2.0, 2.0]); 6], budget);
+        let same = sizes_by_need(&[Some([2.0, 2.0]); 6], budget, MIN_SIDE_RATIO);
         assert!(
             same.iter().flatten().all(|s| s.abs_diff(418) <= 1),
             "{same:?}"
         );
         // No need at all: equal sizes.
-        assert_eq!(sizes_by_need(&[None, None], budget), equal_sizes(2, budget));
+        assert_eq!(
+            sizes_by_need(&[None, None], budget, MIN_SIDE_RATIO),
+            equal_sizes(2, budget)
+        );
     }
 }

@@ -241,9 +241,10 @@
 //! full face. With the light among the visible receivers every face is kept, and the
 //! faces toward the eye need several times the texels of the others:
 //! [`FaceSizes::ByNeed`] sizes each face by the density it needs (predicted on the
-//! receivers' box; `shadowmap::fit` measures it on the eye's samples when it has
-//! them, see [`CubeMap::set_sizes_by_need`]), so every face is predicted to reach the
-//! same error. The faces' maps are then tiles of one atlas ([`CubeMap::atlas`],
+//! receivers' box, so that every face is predicted to reach the same error;
+//! `shadowmap::fit` measures the needs on the eye's samples when it has them and
+//! sizes the faces for the least texels that serve 95% of those samples over all
+//! faces, see [`CubeMap::set_sizes_by_need_with_floor`]). The faces' maps are then tiles of one atlas ([`CubeMap::atlas`],
 //! shelves of tiles, the largest first, at the shelf width that gives the smallest
 //! atlas), and its whole area is what the map costs
 //! ([`CubeMap::texels`]); [`CubeMap::atlas_sample`] turns a face's sample into atlas
@@ -291,16 +292,16 @@
 //!
 //! | configuration | DPSM | IPSM exact | cube, by need | cube, equal full faces | RTW over the faces | tiled |
 //! |---|---|---|---|---|---|---|
-//! | `point_near` | 4.73 | 2.62 | 1.90 (5 faces) | 2.46 | 1.19 | 0.79 |
-//! | `point_mid` | 28.9 | 13.2 | 7.48 (5 faces) | 18.6 | 1.69 | 1.90 |
-//! | `point_far` | 115 | 55.7 | 27.2 (5 faces) | 97.2 | 2.68 | 3.40 |
-//! | `point_inside` | 5.02 | 4.56 | 5.04 (6 faces) | 5.42 | 1.06 | 1.47 |
-//! | `facing_point` | 18.4 | 15.5 | 11.9 (6 faces) | 23.7 | 1.91 | 1.97 |
+//! | `point_near` | 4.73 | 2.62 | 1.75 (5 faces) | 2.46 | 1.19 | 0.79 |
+//! | `point_mid` | 28.9 | 13.2 | 7.24 (5 faces) | 18.6 | 1.69 | 1.90 |
+//! | `point_far` | 115 | 55.7 | 25.6 (5 faces) | 97.2 | 2.47 | 3.40 |
+//! | `point_inside` | 5.02 | 4.56 | 4.64 (6 faces) | 5.42 | 1.06 | 1.47 |
+//! | `facing_point` | 18.4 | 15.5 | 10.3 (6 faces) | 23.7 | 1.90 | 1.97 |
 //!
 //! With the light among the visible receivers every face is kept, and six equal maps
 //! of `1024² / 6` texels lose to a DPSM's two of `1024² / 2` (1.08 and 1.29 times its
-//! `m`); sized by need, the faces toward the eye get the texels and the cube halves
-//! the DPSM's error or better. The focused fit costs about 0.1 ms with equal faces
+//! `m`); sized by need, the faces toward the eye get the texels and the cube has
+//! 0.22 to 0.56 times the DPSM's error, 0.92 times with the light inside the view. The focused fit costs about 0.1 ms with equal faces
 //! (`cargo bench --bench paraboloid -- cube_fit`: about 8 times an exact IPSM plan on
 //! the shared development machine); sizing by the prediction on the receivers' box
 //! casts a grid of 24 x 14 view rays on top.

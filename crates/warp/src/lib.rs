@@ -127,7 +127,11 @@
 //!   (automatic length) scale their warp ratio to the fraction of least predicted
 //!   perspective aliasing error (Lloyd et al.), continuously down to the uniform
 //!   fit, so that no warp is predicted worse than the uniform fit anywhere (see
-//!   [`lispsm`]);
+//!   [`lispsm`]). The prediction stands on the receivers' box, not on the surfaces
+//!   the eye sees; a renderer that has those (a G-buffer) can measure the fit on
+//!   them and back off with the options' `strength_scale` (the share of the chosen
+//!   warp ratio to keep; `shadowmap::fit` tries 1, 1/2 and 0 on the eye's samples
+//!   and keeps the finest);
 //! - focus region thinner across the light than `f32` resolves at
 //!   [`MAX_MAP_SIDE`] texels (a point receiver, a tiny scene far from the origin, a
 //!   flat box seen edge-on): the uniform fit widened to [`MIN_RELATIVE_EXTENT`] times

@@ -34,6 +34,13 @@ pub struct LispsmOptions {
     /// The parallel-light fade band (default: full strength above 10 degrees,
     /// uniform below 3).
     pub fade: ParallelFade,
+    /// The share of the chosen warp to apply, in `[0, 1]`: its warp ratio is raised
+    /// to this power (1, the default: the strength the error prediction chose; 0:
+    /// the uniform fit with focusing). For a renderer that measures the fit on its
+    /// own view samples and backs off where the prediction, made on the receivers'
+    /// box, misjudges what the eye sees (`shadowmap::fit` does, given the eye's
+    /// samples).
+    pub strength_scale: f32,
 }
 
 impl Default for LispsmOptions {
@@ -52,6 +59,7 @@ impl LispsmOptions {
             near_hint: 0.0,
             far_hint: f32::INFINITY,
             fade: ParallelFade::DEFAULT,
+            strength_scale: 1.0,
         }
     }
 
@@ -84,8 +92,16 @@ impl LispsmOptions {
         self
     }
 
+    /// Sets [`strength_scale`](Self::strength_scale).
+    #[must_use]
+    pub const fn with_strength_scale(mut self, strength_scale: f32) -> Self {
+        self.strength_scale = strength_scale;
+        self
+    }
+
     pub(crate) fn check(&self) -> Result<(), WarpError> {
         let ok = (-1.0..=1.0).contains(&self.eta)
+            && (0.0..=1.0).contains(&self.strength_scale)
             && self.near_hint >= 0.0
             && self.near_hint.is_finite()
             && self.far_hint > 0.0
@@ -156,6 +172,7 @@ impl FocusBody {
         options.check()?;
         let (s, fade) = warp_strength(&self.focus, &self.view, options);
         let s = predicted_strength(&self.focus, &self.view, s);
+        let s = scaled_strength(&self.focus, s, options.strength_scale);
         let (transform, s) = warp_fit(&self.focus, &self.view, s, options.reversed_z)?;
         Ok(LispsmShadow {
             transform,
@@ -337,6 +354,14 @@ pub(crate) fn turn_invariant(
     b
 }
 
+/// The strength `s` with its warp ratio `1 + s d` raised to `scale` (`d` the focus
+/// body's extent along the warp axis; see `strength_scale` of the options): 1 keeps
+/// it, 0 is the uniform fit.
+pub(crate) fn scaled_strength(f: &Focus, s: f64, scale: f32) -> f64 {
+    let (y0, y1) = f.warp_axis_range();
+    crate::xpsm::faded_length(s, (y1 - y0).max(0.0), f64::from(scale))
+}
+
 /// The strength to use for a warp whose formula asks for `s_formula`: the fraction
 /// of its warp ratio, `ln(1 + s d)`, of least predicted error (see
 /// [`Probe::strength`]), so that the fit degrades continuously to the uniform fit
@@ -369,12 +394,30 @@ pub(crate) fn predicted_strength(f: &Focus, view: &View, s_formula: f64) -> f64 
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use glam::{DVec3, Vec3};
     use shadowmap_frustum::{Aabb, Camera, Projection, ShadowMapping, ShadowTransform};
 
     use super::*;
     use crate::{UniformOptions, uniform_focused};
+
+    /// The overhead case: a camera 10 m up looking level along `-z` (fovY 60°,
+    /// n = 1, f = 1000) over receivers and casters that hold its whole frustum.
+    pub(crate) fn overhead_view() -> (Vec3, Camera, SceneBounds) {
+        let eye = Vec3::new(0.0, 10.0, 0.0);
+        let camera = Camera::look_to(
+            eye,
+            Vec3::NEG_Z,
+            Vec3::Y,
+            Projection::perspective(60f32.to_radians(), 1.0, 1.0, 1000.0),
+        )
+        .unwrap();
+        let scene = SceneBounds::whole(Aabb::new(
+            Vec3::new(-800.0, -800.0, -1100.0),
+            Vec3::new(800.0, 800.0, 10.0),
+        ));
+        (eye, camera, scene)
+    }
 
     /// Texel density (texture units per world unit) along the view axis and across
     /// it, at view depth `z`, by central differences.
@@ -499,6 +542,72 @@ mod tests {
         let (a0, _) = density(&u, eye.as_dvec3(), 1.0);
         let (a1, _) = density(&u, eye.as_dvec3(), 1000.0);
         assert!((a0 / a1 - 1.0).abs() < 1e-3);
+    }
+
+    /// `strength_scale` raises the chosen warp ratio to its power: over the overhead
+    /// case (warp ratio `sqrt(f / n)` across the view, its square along it), half
+    /// the scale gives the ratio's square root and none the uniform fit, for
+    /// LiSPSM, TSM and XPSM alike; a scale outside `[0, 1]` is refused.
+    #[test]
+    fn strength_scale_raises_the_warp_ratio_to_its_power() {
+        use crate::{TsmOptions, XpsmOptions, tsm, xpsm};
+        let (eye, camera, scene) = overhead_view();
+        let light = Vec3::NEG_Y;
+        // The warp ratio across the view between view depths 1 and 1000.
+        let across = |t: &ShadowTransform| {
+            let (near, far) = (
+                density(t, eye.as_dvec3(), 1.0),
+                density(t, eye.as_dvec3(), 1000.0),
+            );
+            near.1 / far.1
+        };
+        let fits = |scale: f32| {
+            [
+                lispsm(
+                    &camera,
+                    light,
+                    &scene,
+                    &LispsmOptions::default().with_strength_scale(scale),
+                )
+                .map(|s| s.transform),
+                tsm(
+                    &camera,
+                    light,
+                    &scene,
+                    &TsmOptions::default().with_strength_scale(scale),
+                )
+                .map(|s| s.transform),
+                xpsm(
+                    &camera,
+                    light,
+                    &scene,
+                    &XpsmOptions::default().with_strength_scale(scale),
+                )
+                .map(|s| s.transform),
+            ]
+        };
+        for ((full, half), none) in fits(1.0).iter().zip(fits(0.5)).zip(fits(0.0)) {
+            let (full, half, none) = (
+                across(full.as_ref().unwrap()),
+                across(&half.unwrap()),
+                across(&none.unwrap()),
+            );
+            assert!(full > 5.0, "{full}");
+            assert!((half / full.sqrt() - 1.0).abs() < 0.02, "{half} vs {full}");
+            assert!((none - 1.0).abs() < 1e-3, "{none}");
+        }
+        for scale in [-0.1, 1.5, f32::NAN] {
+            assert!(
+                fits(scale)
+                    .iter()
+                    .all(|f| matches!(f, Err(WarpError::InvalidOption)))
+            );
+        }
+        // The default is the full chosen strength.
+        assert_eq!(
+            fits(1.0)[0],
+            lispsm(&camera, light, &scene, &LispsmOptions::default()).map(|s| s.transform)
+        );
     }
 
     #[test]

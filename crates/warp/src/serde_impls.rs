@@ -50,6 +50,7 @@ struct LispsmOptionsDef {
     #[serde(with = "infinite_as_none")]
     far_hint: f32,
     fade: ParallelFade,
+    strength_scale: f32,
 }
 
 shadowmap_frustum::__deserialize_checked!(
@@ -65,6 +66,7 @@ struct TsmOptionsDef {
     reversed_z: bool,
     focus: f32,
     fade: ParallelFade,
+    strength_scale: f32,
 }
 
 shadowmap_frustum::__deserialize_checked!(
@@ -81,6 +83,7 @@ struct XpsmOptionsDef {
     epsilon_w: f32,
     coef: Option<f32>,
     miner_lamp_threshold: f32,
+    strength_scale: f32,
 }
 
 shadowmap_frustum::__deserialize_checked!(

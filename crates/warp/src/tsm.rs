@@ -6,7 +6,7 @@ use shadowmap_frustum::{Camera, MAX_BODY_VERTICES, ShadowTransform};
 
 use crate::FocusBody;
 use crate::focus::{Focus, View};
-use crate::lispsm::{predicted_strength, warp_fit};
+use crate::lispsm::{predicted_strength, scaled_strength, warp_fit};
 use crate::{MAX_WARP_RATIO, WarpError};
 use crate::{ParallelFade, SceneBounds};
 
@@ -24,6 +24,13 @@ pub struct TsmOptions {
     /// The parallel-light fade band (default: full strength above 10 degrees,
     /// uniform below 3).
     pub fade: ParallelFade,
+    /// The share of the chosen warp to apply, in `[0, 1]`: its warp ratio is raised
+    /// to this power (1, the default: the strength the error prediction chose; 0:
+    /// the uniform fit with focusing). For a renderer that measures the fit on its
+    /// own view samples and backs off where the prediction, made on the receivers'
+    /// box, misjudges what the eye sees (`shadowmap::fit` does, given the eye's
+    /// samples).
+    pub strength_scale: f32,
 }
 
 impl Default for TsmOptions {
@@ -40,6 +47,7 @@ impl TsmOptions {
             reversed_z: false,
             focus: 0.1,
             fade: ParallelFade::DEFAULT,
+            strength_scale: 1.0,
         }
     }
 
@@ -64,8 +72,18 @@ impl TsmOptions {
         self
     }
 
+    /// Sets [`strength_scale`](Self::strength_scale).
+    #[must_use]
+    pub const fn with_strength_scale(mut self, strength_scale: f32) -> Self {
+        self.strength_scale = strength_scale;
+        self
+    }
+
     pub(crate) fn check(&self) -> Result<(), WarpError> {
-        let ok = self.focus > 0.0 && self.focus < 1.0 && self.fade.is_valid();
+        let ok = self.focus > 0.0
+            && self.focus < 1.0
+            && self.fade.is_valid()
+            && (0.0..=1.0).contains(&self.strength_scale);
         if ok {
             Ok(())
         } else {
@@ -179,6 +197,7 @@ fn tsm_body(view: &View, f: &Focus, options: &TsmOptions) -> Result<TsmShadow, W
     }
     let s = if s.is_finite() { s * fade } else { 0.0 };
     let s = predicted_strength(f, view, s);
+    let s = scaled_strength(f, s, options.strength_scale);
     let (transform, s) = warp_fit(f, view, s, options.reversed_z)?;
     Ok(TsmShadow {
         transform,
@@ -209,24 +228,13 @@ fn focus_region_top(yd: &[(f64, f64)], z: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use glam::{DVec3, Vec3};
-    use shadowmap_frustum::{Aabb, Camera, Projection, ShadowMapping};
+    use shadowmap_frustum::ShadowMapping;
 
     use super::*;
 
     #[test]
     fn the_focus_point_lands_on_the_80_percent_line() {
-        let eye = Vec3::new(0.0, 10.0, 0.0);
-        let camera = Camera::look_to(
-            eye,
-            Vec3::NEG_Z,
-            Vec3::Y,
-            Projection::perspective(60f32.to_radians(), 1.0, 1.0, 1000.0),
-        )
-        .unwrap();
-        let scene = SceneBounds::whole(Aabb::new(
-            Vec3::new(-800.0, -800.0, -1100.0),
-            Vec3::new(800.0, 800.0, 10.0),
-        ));
+        let (eye, camera, scene) = crate::lispsm::tests::overhead_view();
         for focus in [0.05f32, 0.1, 0.3, 0.6] {
             let t = tsm(
                 &camera,

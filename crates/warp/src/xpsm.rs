@@ -7,7 +7,7 @@ use shadowmap_frustum::{Camera, ShadowTransform};
 use crate::FocusBody;
 use crate::WarpError;
 use crate::focus::{Bounds, Focus, View, finish, scale_of, smoothstep};
-use crate::lispsm::turn_invariant;
+use crate::lispsm::{scaled_strength, turn_invariant};
 use crate::predict::Probe;
 use shadowmap_frustum::math;
 
@@ -33,6 +33,13 @@ pub struct XpsmOptions {
     /// switches at 0.1; here the projection vector fades out between twice this
     /// value and this value, so nothing pops. Default 0.1.
     pub miner_lamp_threshold: f32,
+    /// The share of the chosen warp to apply, in `[0, 1]`: its warp ratio is raised
+    /// to this power (1, the default: the strength the error prediction chose; 0:
+    /// the orthographic fit with focusing). For a renderer that measures the fit on its
+    /// own view samples and backs off where the prediction, made on the receivers'
+    /// box, misjudges what the eye sees (`shadowmap::fit` does, given the eye's
+    /// samples).
+    pub strength_scale: f32,
 }
 
 impl Default for XpsmOptions {
@@ -50,6 +57,7 @@ impl XpsmOptions {
             epsilon_w: 0.1,
             coef: None,
             miner_lamp_threshold: 0.1,
+            strength_scale: 1.0,
         }
     }
 
@@ -81,6 +89,13 @@ impl XpsmOptions {
         self
     }
 
+    /// Sets [`strength_scale`](Self::strength_scale).
+    #[must_use]
+    pub const fn with_strength_scale(mut self, strength_scale: f32) -> Self {
+        self.strength_scale = strength_scale;
+        self
+    }
+
     pub(crate) fn validate(&self) -> Result<(), WarpError> {
         let coef_ok = match self.coef {
             Some(c) => c.is_finite() && c >= 0.0,
@@ -90,7 +105,8 @@ impl XpsmOptions {
             && self.epsilon_w < 1.0
             && coef_ok
             && self.miner_lamp_threshold >= 0.0
-            && self.miner_lamp_threshold < 0.5;
+            && self.miner_lamp_threshold < 0.5
+            && (0.0..=1.0).contains(&self.strength_scale);
         if ok {
             Ok(())
         } else {
@@ -261,6 +277,7 @@ fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow
             (predicted_length(view, f, options, length, shift), shift)
         }
     };
+    let length_p = scaled_strength(f, length_p, options.strength_scale);
     let fit = xpsm_fit(view, f, options, length_p, shift)?;
     let transform = finish(
         f.rot,
@@ -513,7 +530,7 @@ fn xpsm_fit(
 /// most of a strong warp until the weight is nearly 0: a warp ratio of 50 at weight
 /// 0.075 stays 4.7, not 1.34, and a sweep case with a low sun 6.7° off the view
 /// lost 1.29x to the uniform fit on it.)
-fn faded_length(full: f64, d: f64, weight: f64) -> f64 {
+pub(crate) fn faded_length(full: f64, d: f64, weight: f64) -> f64 {
     if weight >= 1.0 || !(d > 0.0) {
         return full * weight.min(1.0);
     }

@@ -1,0 +1,174 @@
+//! The single warps of [`fit`](crate::fit) (LiSPSM, XPSM, TSM): the warp crate's fit
+//! at the strength its error prediction chooses, backed off where the eye's samples
+//! measure it worse.
+
+use glam::Vec3;
+use shadowmap_frustum::{Light, LightDirection, ShadowMapping};
+use shadowmap_warp::{lispsm, tsm, xpsm};
+
+use crate::auto::AUTO_MAX_SAMPLES;
+use crate::fit::{FitError, FitInput};
+use crate::sample_error::{Samples, Unlit, sample_error};
+use crate::shadow::Fitted;
+use crate::technique::Technique;
+
+/// Shares of the predicted warp tried on the eye's samples (the options'
+/// `strength_scale`, times the caller's): the prediction's strength, half its warp
+/// ratio, and none (the uniform fit with focusing).
+const SCALES: [f32; 3] = [1.0, 0.5, 0.0];
+
+/// LiSPSM, XPSM or TSM (`technique`) for a light travelling along `direction`.
+///
+/// The warp crate chooses each warp's strength on a prediction over the receivers'
+/// box, which stands in for the surfaces the eye sees. Where the frame has the eye's
+/// samples (and the image's focal length), the warp is also fitted at half its warp
+/// ratio and at none, each measured on them as the quality report measures
+/// (`sample_error`: the 95th percentile of `m` over at most [`AUTO_MAX_SAMPLES`]
+/// front-lit samples, as `auto` ranks its candidates), and the finest is kept (the
+/// strongest on ties). So a warp is never worse than the uniform fit on the
+/// samples it was given: in a small room seen looking down, under a light from
+/// above, the box predicted the full warps 0.67 to 0.7 times the uniform fit's
+/// error and they measured 1.56 to 1.85 times it (the room's walls and furniture,
+/// not its floor, hold the largest errors).
+pub(crate) fn fit_warp(
+    technique: &Technique,
+    direction: Vec3,
+    input: &FitInput<'_>,
+) -> Result<Fitted, FitError> {
+    let (camera, scene) = (input.camera, &input.scene);
+    let fit_at = |scale: f32| -> Result<Fitted, FitError> {
+        Ok(match technique {
+            Technique::Lispsm(o) => {
+                let o = o.with_strength_scale(o.strength_scale * scale);
+                Fitted::Lispsm(lispsm(camera, direction, scene, &o)?)
+            }
+            Technique::Xpsm(o) => {
+                let o = o.with_strength_scale(o.strength_scale * scale);
+                Fitted::Xpsm(xpsm(camera, direction, scene, &o)?)
+            }
+            Technique::Tsm(o) => {
+                let o = o.with_strength_scale(o.strength_scale * scale);
+                Fitted::Tsm(tsm(camera, direction, scene, &o)?)
+            }
+            _ => return Err(FitError::NoCandidate),
+        })
+    };
+    let predicted = fit_at(SCALES[0])?;
+    let (Some(samples), Some(ppr), Light::Directional { .. }) =
+        (input.eye_samples, input.pixels_per_radian, *input.light)
+    else {
+        return Ok(predicted);
+    };
+    let samples = Samples {
+        most: AUTO_MAX_SAMPLES,
+        unlit: Unlit::Skipped,
+        ..Samples::new(camera, ppr, samples)
+    };
+    let light = LightDirection::Directional(direction);
+    let measure = |fitted: &Fitted| {
+        let mapping: &dyn ShadowMapping = match fitted {
+            Fitted::Lispsm(s) => &s.transform,
+            Fitted::Xpsm(s) => &s.transform,
+            Fitted::Tsm(s) => &s.transform,
+            _ => return None,
+        };
+        sample_error(mapping, 1.0, &samples, light, 0.95)
+    };
+    let Some(mut least) = measure(&predicted) else {
+        return Ok(predicted);
+    };
+    let mut best = predicted;
+    for scale in SCALES.into_iter().skip(1) {
+        let Ok(fitted) = fit_at(scale) else { continue };
+        if let Some(e) = measure(&fitted).filter(|e| *e < least) {
+            (least, best) = (e, fitted);
+        }
+    }
+    Ok(best)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use shadowmap_frustum::{Aabb, Camera, Light, LightDirection, Projection, SceneBounds};
+    use shadowmap_warp::{LispsmOptions, TsmOptions, XpsmOptions};
+
+    use super::*;
+    use crate::fit::{depth_bounds_of, fit};
+    use crate::test_views::{room_samples, unit_random};
+
+    /// With the eye's samples, LiSPSM, XPSM and TSM are never measured worse on them
+    /// than their own uniform fit (the strength scaled to 0), over views of a room
+    /// from its corners under lights from above at every angle; and the prediction
+    /// alone is, in some of them (not a test that always warps in full).
+    #[test]
+    fn with_eye_samples_a_warp_is_never_worse_than_its_uniform_fit_on_them() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || unit_random(&mut state);
+        let room = Aabb::new(Vec3::new(-3.0, 0.0, -4.0), Vec3::new(3.0, 2.8, 4.0));
+        let (mut checked, mut backed_off) = (0, 0);
+        for _ in 0..60 {
+            let eye = Vec3::new(4.0 * next() - 2.0, 1.2 + next(), 6.0 * next() - 3.0);
+            let heading = core::f32::consts::TAU * next();
+            let forward = Vec3::new(heading.sin(), -0.6 * next(), heading.cos());
+            let camera = Camera::look_to(
+                eye,
+                forward,
+                Vec3::Y,
+                Projection::perspective(1.0, 1.5, 0.1, 20.0),
+            )
+            .unwrap();
+            let tilt = 0.7 * next();
+            let azimuth = core::f32::consts::TAU * next();
+            let direction = Vec3::new(tilt * azimuth.cos(), -1.0, tilt * azimuth.sin());
+            let light = Light::Directional { direction };
+            let samples = room_samples(&camera, &room, 64, 48);
+            let boxed = crate::FitInput::new(&camera, &light, SceneBounds::whole(room), 1 << 14)
+                .with_depth_bounds(depth_bounds_of(&camera, &samples));
+            let input = boxed
+                .with_eye_samples(&samples)
+                .with_pixels_per_radian(48.0);
+            let measured = |shadow: &crate::Shadow| {
+                let samples = Samples {
+                    unlit: Unlit::Skipped,
+                    most: AUTO_MAX_SAMPLES,
+                    ..Samples::new(&camera, 48.0, &samples)
+                };
+                let light = LightDirection::Directional(direction);
+                sample_error(shadow.transform()?, 1.0, &samples, light, 0.95)
+            };
+            for (full, none) in [
+                (
+                    Technique::Lispsm(LispsmOptions::default()),
+                    Technique::Lispsm(LispsmOptions::default().with_strength_scale(0.0)),
+                ),
+                (
+                    Technique::Xpsm(XpsmOptions::default()),
+                    Technique::Xpsm(XpsmOptions::default().with_strength_scale(0.0)),
+                ),
+                (
+                    Technique::Tsm(TsmOptions::default()),
+                    Technique::Tsm(TsmOptions::default().with_strength_scale(0.0)),
+                ),
+            ] {
+                let (Ok(chosen), Ok(uniform), Ok(predicted)) =
+                    (fit(&full, &input), fit(&none, &input), fit(&full, &boxed))
+                else {
+                    continue;
+                };
+                let (Some(c), Some(u), Some(p)) =
+                    (measured(&chosen), measured(&uniform), measured(&predicted))
+                else {
+                    continue;
+                };
+                assert!(c <= u * (1.0 + 1e-9), "{}: {c} vs {u}", full.name());
+                checked += 1;
+                backed_off += usize::from(p > u * 1.05);
+            }
+        }
+        assert!(
+            checked > 100 && backed_off > 0,
+            "{checked} checked, {backed_off}"
+        );
+    }
+}
