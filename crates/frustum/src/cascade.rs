@@ -354,15 +354,13 @@ impl ShadowMapping for CascadeSet {
         Some(s)
     }
 
-    /// Every point selected by view depth, all in one cascade; that cascade's
-    /// derivative.
+    /// The derivative of the cascade that stores `centre` (selected by view depth),
+    /// whichever cascades store the points `around` it: the texel footprint at a
+    /// point is that of its own map. (Leaving out the points whose neighbours cross
+    /// into another cascade leaves out, at a coarse sampling of the image, most
+    /// points of the far cascades, whose slices are deep.)
     fn uv_differentials(&self, centre: DVec3, around: &[DVec3; 4]) -> Option<[DVec2; 2]> {
         let index = self.select_by_depth(centre.as_vec3())?.index;
-        for p in around {
-            if self.select_by_depth(p.as_vec3())?.index != index {
-                return None;
-            }
-        }
         let cascade = self.cascades.get(index)?;
         projective_uv_differentials(&cascade.transform.uv_from_world.as_dmat4(), centre, around)
     }

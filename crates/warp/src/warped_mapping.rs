@@ -77,15 +77,10 @@ impl ShadowMapping for WarpedCascadesView<'_> {
         Some(sample)
     }
 
-    /// Every point selected by view depth, all in one cascade; that cascade's
-    /// derivative.
+    /// The derivative of the cascade that stores `centre` (selected by view depth),
+    /// whichever cascades store the points `around` it, as `CascadeSet`'s.
     fn uv_differentials(&self, centre: DVec3, around: &[DVec3; 4]) -> Option<[DVec2; 2]> {
         let index = self.cascades.select_by_depth(self.view_depth(centre))?;
-        for p in around {
-            if self.cascades.select_by_depth(self.view_depth(*p))? != index {
-                return None;
-            }
-        }
         let shadow = self.cascades.cascades.get(index)?.shadow.as_ref()?;
         shadow.transform.uv_differentials(centre, around)
     }
