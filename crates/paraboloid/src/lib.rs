@@ -292,11 +292,11 @@
 //!
 //! | configuration | DPSM | IPSM exact | cube, by need | cube, equal full faces | RTW over the faces | tiled |
 //! |---|---|---|---|---|---|---|
-//! | `point_near` | 4.73 | 2.62 | 1.75 (5 faces) | 2.46 | 1.19 | 0.79 |
-//! | `point_mid` | 28.9 | 13.2 | 7.24 (5 faces) | 18.6 | 1.69 | 1.90 |
+//! | `point_near` | 4.73 | 2.62 | 1.72 (5 faces) | 2.46 | 1.14 | 0.79 |
+//! | `point_mid` | 28.9 | 13.2 | 7.22 (5 faces) | 18.6 | 1.64 | 1.90 |
 //! | `point_far` | 115 | 55.7 | 25.6 (5 faces) | 97.2 | 2.47 | 3.40 |
-//! | `point_inside` | 5.02 | 4.56 | 4.64 (6 faces) | 5.42 | 1.06 | 1.47 |
-//! | `facing_point` | 18.4 | 15.5 | 10.3 (6 faces) | 23.7 | 1.90 | 1.97 |
+//! | `point_inside` | 5.02 | 4.56 | 4.63 (6 faces) | 5.42 | 1.04 | 1.47 |
+//! | `facing_point` | 18.4 | 15.5 | 10.3 (6 faces) | 23.7 | 1.79 | 1.97 |
 //!
 //! With the light among the visible receivers every face is kept, and six equal maps
 //! of `1024² / 6` texels lose to a DPSM's two of `1024² / 2` (1.08 and 1.29 times its
