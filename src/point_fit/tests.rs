@@ -1,0 +1,354 @@
+//! Tests of the point-light fits.
+
+use super::*;
+use crate::{Technique, fit};
+use glam::Vec3;
+use proptest::prelude::*;
+use shadowmap_frustum::SceneBounds;
+use shadowmap_testgen::point_rtw::{
+    CubeSamplesCase, PointRtwCase, check_cube_samples, check_point_rtw, check_tiled_samples,
+    cube_samples_case, point_rtw_case,
+};
+use shadowmap_testgen::strategy;
+
+/// Fits RTW over the paraboloid to a case and checks its coverage; the number of
+/// samples checked (0 when the fit refuses the case, e.g. a spot light).
+fn fit_and_check(case: &PointRtwCase) -> usize {
+    let input = FitInput::new(
+        &case.plan.camera,
+        &case.plan.light,
+        // IPSM reads the camera and depth bounds, not the scene.
+        SceneBounds::whole(shadowmap_frustum::Aabb::new(Vec3::splat(-1.0), Vec3::ONE)),
+        1 << 16,
+    )
+    .with_eye_samples(&case.samples)
+    .with_depth_bounds(case.plan.bounds);
+    let technique = Technique::PointRtw {
+        ipsm: case.plan.options,
+        rtw: RtwPlan::default().with_importance_side(32),
+    };
+    let Ok(shadow) = fit(&technique, &input) else {
+        return 0;
+    };
+    let Fitted::PointRtw { plan, .. } = shadow.fitted() else {
+        panic!("point_rtw fitted something else");
+    };
+    assert_eq!(shadow.layers(), plan.map.layers());
+    check_point_rtw(case, &plan.map, &shadow)
+}
+
+/// Fits the cube maps (faces sized by the samples' needs) or RTW over their faces
+/// to a case and checks coverage of the samples; the number checked (0 when the
+/// fit refuses the case: nothing visible in range).
+fn fit_cube_and_check(case: &CubeSamplesCase, warped: bool) -> Result<usize, String> {
+    let c = &case.cube;
+    let budget = 1 << 16;
+    let input = FitInput::new(&c.camera, &c.light, c.scene, budget)
+        .with_eye_samples(&case.samples)
+        .with_depth_bounds(c.bounds)
+        .with_pixels_per_radian(case.pixels_per_radian);
+    let technique = if warped {
+        Technique::CubeRtw {
+            cube: c.options,
+            rtw: RtwPlan::default().with_importance_side(32),
+        }
+    } else {
+        Technique::CubeMaps(c.options.with_sizes(FaceSizes::ByNeed))
+    };
+    let Ok(shadow) = fit(&technique, &input) else {
+        return Ok(0);
+    };
+    let cube = shadow.cube().ok_or("not a cube map")?;
+    if let Fitted::CubeRtw { warps, .. } = shadow.fitted() {
+        assert_eq!(warps.len(), cube.faces.len());
+    }
+    assert_eq!(shadow.texels(), cube.texels());
+    check_cube_samples(case, cube, &shadow, budget)
+}
+
+/// Fits tiled cube maps to a case and checks that the tiles store every sample
+/// the cube's windows store, inside an atlas of the budget; the number checked.
+fn fit_tiled_and_check(case: &CubeSamplesCase) -> Result<usize, String> {
+    let c = &case.cube;
+    let budget = 1 << 16;
+    let input = FitInput::new(&c.camera, &c.light, c.scene, budget)
+        .with_eye_samples(&case.samples)
+        .with_depth_bounds(c.bounds)
+        .with_pixels_per_radian(case.pixels_per_radian);
+    let technique = Technique::TiledCube {
+        cube: c.options,
+        tiles: TileOptions::default(),
+    };
+    let Ok(shadow) = fit(&technique, &input) else {
+        return Ok(0);
+    };
+    let tiled = shadow.tiled_cube().ok_or("not a tiled cube map")?;
+    assert_eq!(shadow.texels(), tiled.texels());
+    assert_eq!(shadow.layers(), tiled.layers());
+    check_tiled_samples(case, tiled, &shadow, budget)
+}
+
+/// The densities serve all but 5% of the samples and give up the costliest: a
+/// cell's lone outlier (a grazing sample) rather than the many samples of a
+/// busy cell; a cell whose samples are given up keeps half the common need.
+#[test]
+fn cell_densities_give_up_the_costliest_samples() {
+    let mut needs: Vec<(usize, f64)> = Vec::new();
+    // Cell 0: 60 samples needing 10 to 69; cell 1: 37 samples needing 5 and
+    // one needing 1000; cell 3: two samples needing 400 and 300.
+    needs.extend((0..60).map(|i| (0, 10.0 + f64::from(i))));
+    needs.extend((0..37).map(|_| (1, 5.0)));
+    needs.push((1, 1000.0));
+    needs.extend([(3, 400.0), (3, 300.0)]);
+    let mut values: Vec<f64> = needs.iter().map(|n| n.1).collect();
+    let floor = GIVEN_UP_FLOOR * percentile(&mut values).unwrap();
+    assert!((60.0..70.0).contains(&(floor / GIVEN_UP_FLOOR)), "{floor}");
+    let d = cell_densities(&mut needs, 4);
+    // 100 samples: 5 given up. The outlier of cell 1 first (the largest saving),
+    // then cell 3's two (400² and 300² against nothing), then two of cell 0's;
+    // the given-up cells keep the floor.
+    assert_eq!(d[1], floor);
+    assert_eq!(d[3], floor);
+    assert_eq!(d[0], 67.0);
+    assert_eq!(d[2], 0.0);
+    // Nothing to give up: every cell at its largest need.
+    let mut few = vec![(0, 2.0), (1, 3.0), (1, 7.0)];
+    assert_eq!(cell_densities(&mut few, 2), vec![2.0, 7.0]);
+}
+
+/// Texels of densities (the sum of their squares).
+fn texels(densities: &[f64]) -> f64 {
+    densities.iter().map(|d| d * d).sum()
+}
+
+/// The faces' densities are the least texels that serve all but 5% of the
+/// samples: equal to a brute force over how many each face gives up, on random
+/// needs; and where a face's largest needs are many and alike (no single sample
+/// given up saves anything), fewer than the greedy choice of the largest saving.
+#[test]
+fn face_densities_are_the_least_texels_that_serve_the_percentile() {
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..40 {
+        let faces = 1 + (next() * 4.0) as usize;
+        let mut needs: Vec<(usize, f64)> = (0..60)
+            .map(|_| {
+                (
+                    (next() * faces as f64) as usize,
+                    1.0 + 100.0 * next() * next(),
+                )
+            })
+            .collect();
+        let found = face_densities(&mut needs.clone(), faces);
+        // Brute force: every way of giving up at most 3 samples (5% of 60).
+        let mut all: Vec<f64> = needs.iter().map(|n| n.1).collect();
+        let common = percentile(&mut all).unwrap();
+        needs.sort_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
+        let of_face =
+            |f: usize| -> Vec<f64> { needs.iter().filter(|n| n.0 == f).map(|n| n.1).collect() };
+        let density = |face: &[f64], k: usize| {
+            face.first().map_or(0.0, |top| {
+                face.get(k)
+                    .copied()
+                    .unwrap_or(0.0)
+                    .max(GIVEN_UP_FLOOR * top.min(common))
+            })
+        };
+        let mut least = f64::INFINITY;
+        for code in 0..4usize.pow(faces as u32) {
+            let ks: Vec<usize> = (0..faces)
+                .map(|f| code / 4usize.pow(f as u32) % 4)
+                .collect();
+            if ks.iter().sum::<usize>() <= 3 {
+                let d: Vec<f64> = (0..faces).map(|f| density(&of_face(f), ks[f])).collect();
+                least = least.min(texels(&d));
+            }
+        }
+        assert!(
+            (texels(&found) - least).abs() <= 1e-9 * least,
+            "{found:?}: {least}"
+        );
+    }
+    // Face 0: ten samples needing 100 and ninety needing 50; face 1: a hundred
+    // needing 90 down to 80.5. Ten may be given up: all of face 0's top saves
+    // 100² - 50² where the greedy choice gives up face 1's top for 0.1 steps.
+    let mut needs: Vec<(usize, f64)> = (0..10).map(|_| (0, 100.0)).collect();
+    needs.extend((0..90).map(|_| (0, 50.0)));
+    needs.extend((0..100).map(|i| (1, 90.0 - 0.1 * f64::from(i))));
+    let exact = face_densities(&mut needs.clone(), 2);
+    assert_eq!(exact.as_slice(), &[50.0, 90.0]);
+    let greedy = cell_densities(&mut needs, 2);
+    assert!(texels(&greedy) > 1.3 * texels(&exact), "{greedy:?}");
+}
+
+/// The fit inputs of up to `count` generated point-light cases with their eye
+/// samples and depth bounds (the scene a unit box: IPSM reads the camera and
+/// depth bounds, not the scene), from the xorshift `seed`.
+fn point_cases(seed: u64, count: usize) -> Vec<PointRtwCase> {
+    use shadowmap_testgen::arbitrary::Unstructured;
+    let mut state = seed;
+    (0..count)
+        .filter_map(|_| {
+            let bytes = shadowmap_testgen::xorshift_bytes(&mut state, 512);
+            point_rtw_case(&mut Unstructured::new(&bytes)).ok()
+        })
+        .collect()
+}
+
+/// The fit input of a generated point-light case.
+fn point_input(case: &PointRtwCase) -> FitInput<'_> {
+    FitInput::new(
+        &case.plan.camera,
+        &case.plan.light,
+        SceneBounds::whole(shadowmap_frustum::Aabb::new(Vec3::splat(-1.0), Vec3::ONE)),
+        1 << 16,
+    )
+    .with_eye_samples(&case.samples)
+    .with_depth_bounds(case.plan.bounds)
+}
+
+/// RTW over each side of the paraboloid is never worse, on the samples it was
+/// built from, than that side unwarped (the strength 0 among those measured).
+#[test]
+fn point_rtw_is_never_worse_than_its_paraboloid_on_its_samples() {
+    let mut checked = 0;
+    for case in point_cases(0x5851_f42d_4c95_7f2d, 200) {
+        let input = point_input(&case);
+        let rtw = RtwPlan::default().with_importance_side(32);
+        let technique = Technique::PointRtw {
+            ipsm: case.plan.options,
+            rtw,
+        };
+        let Ok(shadow) = fit(&technique, &input) else {
+            continue;
+        };
+        let Fitted::PointRtw { plan, front, back } = shadow.fitted() else {
+            panic!("point_rtw fitted something else");
+        };
+        let mut ones = ImportanceMap::new(32, 32).unwrap();
+        for (x, y) in (0..32).flat_map(|x| (0..32).map(move |y| (x, y))) {
+            ones.set(x, y, 1.0).unwrap();
+        }
+        let mut identity = WarpMaps::new(32, 32).unwrap();
+        identity.build(&ones, &rtw.warp).unwrap();
+        let light = LightDirection::Position(plan.map.position);
+        for (side, warps) in [(Side::Front, Some(front)), (Side::Back, back.as_ref())] {
+            let Some(warps) = warps else { continue };
+            let error = |warps: &WarpMaps| {
+                let mapping = WarpedSide {
+                    map: &plan.map,
+                    side,
+                    warps,
+                };
+                warped_error(&mapping, &case.samples, &case.plan.camera, light)
+            };
+            let (warped, unwarped) = (error(warps), error(&identity));
+            if unwarped.is_finite() {
+                assert!(warped <= unwarped * (1.0 + 1e-9), "{warped} vs {unwarped}");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 50, "{checked} sides checked");
+}
+
+/// IPSM keeps, of its plan and the two dual alternatives, the one of least
+/// error on the front-lit samples, the ones the quality report measures (a
+/// sample the light reaches from behind is dark whatever the map holds).
+#[test]
+fn ipsm_keeps_the_finest_map_on_the_front_lit_samples() {
+    let mut checked = 0;
+    for case in point_cases(0x1405_7b7e_f767_814f, 200) {
+        let budget = 1 << 16;
+        let input = point_input(&case).with_pixels_per_radian(500.0);
+        let options = case.plan.options;
+        let Ok(chosen) = fit_ipsm(&options, &input) else {
+            continue;
+        };
+        let error = |p: &IpsmPlan| {
+            let side = f64::from(layer_side(budget, p.map.layers()));
+            let samples = Samples {
+                unlit: Unlit::Skipped,
+                ..Samples::new(&case.plan.camera, 500.0, &case.samples)
+            };
+            let light = LightDirection::Position(p.map.position);
+            sample_error(&p.map, side, &samples, light, NEED_PERCENTILE)
+        };
+        let Some(kept) = error(&chosen) else { continue };
+        let plan = IpsmPlan::new(
+            &case.plan.light,
+            &case.plan.camera,
+            case.plan.bounds,
+            &options,
+        )
+        .unwrap();
+        let alternatives =
+            [None, Some(-options.up_hint)].map(|axis| plan.with_dual(axis, &options).ok());
+        for other in alternatives.iter().flatten().chain([&plan]) {
+            if let Some(e) = error(other) {
+                assert!(kept <= e, "{kept} kept, {e} on offer");
+            }
+        }
+        checked += 1;
+    }
+    assert!(checked > 50, "{checked} cases");
+}
+
+/// The property below checks samples on most generated cases, with and without
+/// the warp, and tiled (not a generator whose fits all fail).
+#[test]
+fn cube_cases_reach_fitted_maps() {
+    use shadowmap_testgen::arbitrary::Unstructured;
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let (mut fitted, mut checked) = (0, 0);
+    for _ in 0..300 {
+        let bytes = shadowmap_testgen::xorshift_bytes(&mut state, 512);
+        let Ok(case) = cube_samples_case(&mut Unstructured::new(&bytes)) else {
+            continue;
+        };
+        for warped in [false, true] {
+            let n = fit_cube_and_check(&case, warped).unwrap();
+            fitted += usize::from(n > 0);
+            checked += n;
+        }
+        let n = fit_tiled_and_check(&case).unwrap();
+        fitted += usize::from(n > 0);
+        checked += n;
+    }
+    assert!(
+        fitted > 450 && checked > 15_000,
+        "{fitted} fits, {checked} samples"
+    );
+}
+
+proptest! {
+    #![proptest_config(shadowmap_testgen::proptest_config())]
+
+    /// Cube maps sized by the samples' needs, and RTW over their faces (windows
+    /// narrowed to the samples), store every sample: with the light inside the
+    /// view, next to it, far away, inside a caster's bounds.
+    #[test]
+    fn cube_faces_cover_their_samples(case in strategy(cube_samples_case), warped: bool) {
+        fit_cube_and_check(&case, warped).map_err(TestCaseError::fail)?;
+    }
+
+    /// Tiled cube maps store every sample their cube's windows store, each in
+    /// the tile of its face and cell, inside the tile's square of an atlas within
+    /// the budget, the tiles apart.
+    #[test]
+    fn tiled_cube_covers_its_samples(case in strategy(cube_samples_case)) {
+        fit_tiled_and_check(&case).map_err(TestCaseError::fail)?;
+    }
+
+    /// Every sample the IPSM paraboloid stores is stored by RTW over it, in the
+    /// same layer, with the same depth, inside the map.
+    #[test]
+    fn point_rtw_covers_what_the_paraboloid_covers(case in strategy(point_rtw_case)) {
+        fit_and_check(&case);
+    }
+}
