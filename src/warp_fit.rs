@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use shadowmap_frustum::{Light, LightDirection, ShadowMapping};
-use shadowmap_warp::{lispsm, tsm, xpsm};
+use shadowmap_warp::{FocusBody, lispsm, tsm, xpsm};
 
 use crate::auto::AUTO_MAX_SAMPLES;
 use crate::fit::{FitError, FitInput};
@@ -36,19 +36,31 @@ pub(crate) fn fit_warp(
     input: &FitInput<'_>,
 ) -> Result<Fitted, FitError> {
     let (camera, scene) = (input.camera, &input.scene);
+    // One focus body for every strength tried. Where it fails, the warp's own entry
+    // point reports the error it reports (an invalid option before the body's).
+    let body = FocusBody::new(camera, direction, scene).ok();
     let fit_at = |scale: f32| -> Result<Fitted, FitError> {
         Ok(match technique {
             Technique::Lispsm(o) => {
                 let o = o.with_strength_scale(o.strength_scale * scale);
-                Fitted::Lispsm(lispsm(camera, direction, scene, &o)?)
+                Fitted::Lispsm(match &body {
+                    Some(body) => body.lispsm(&o)?,
+                    None => lispsm(camera, direction, scene, &o)?,
+                })
             }
             Technique::Xpsm(o) => {
                 let o = o.with_strength_scale(o.strength_scale * scale);
-                Fitted::Xpsm(xpsm(camera, direction, scene, &o)?)
+                Fitted::Xpsm(match &body {
+                    Some(body) => body.xpsm(&o)?,
+                    None => xpsm(camera, direction, scene, &o)?,
+                })
             }
             Technique::Tsm(o) => {
                 let o = o.with_strength_scale(o.strength_scale * scale);
-                Fitted::Tsm(tsm(camera, direction, scene, &o)?)
+                Fitted::Tsm(match &body {
+                    Some(body) => body.tsm(&o)?,
+                    None => tsm(camera, direction, scene, &o)?,
+                })
             }
             _ => return Err(FitError::NoCandidate),
         })

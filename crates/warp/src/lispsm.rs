@@ -39,7 +39,7 @@ pub struct LispsmOptions {
     /// the uniform fit with focusing). For a renderer that measures the fit on its
     /// own view samples and backs off where the prediction, made on the receivers'
     /// box, misjudges what the eye sees (`shadowmap::fit` does, given the eye's
-    /// samples).
+    /// samples). At 0 the prediction, most of the fit's time, is skipped.
     pub strength_scale: f32,
 }
 
@@ -171,8 +171,7 @@ impl FocusBody {
     pub fn lispsm(&self, options: &LispsmOptions) -> Result<LispsmShadow, WarpError> {
         options.check()?;
         let (s, fade) = warp_strength(&self.focus, &self.view, options);
-        let s = predicted_strength(&self.focus, &self.view, s);
-        let s = scaled_strength(&self.focus, s, options.strength_scale);
+        let s = chosen_strength(&self.focus, &self.view, s, options.strength_scale);
         let (transform, s) = warp_fit(&self.focus, &self.view, s, options.reversed_z)?;
         Ok(LispsmShadow {
             transform,
@@ -362,11 +361,21 @@ pub(crate) fn scaled_strength(f: &Focus, s: f64, scale: f32) -> f64 {
     crate::xpsm::faded_length(s, (y1 - y0).max(0.0), f64::from(scale))
 }
 
+/// The strength a warp fits at: [`predicted_strength`] for its formula's `s_formula`,
+/// scaled by `scale` ([`scaled_strength`]). At `scale` 0 that is the uniform fit
+/// whatever the prediction, so the prediction (most of a warp's cost) is skipped.
+pub(crate) fn chosen_strength(f: &Focus, view: &View, s_formula: f64, scale: f32) -> f64 {
+    if scale <= 0.0 {
+        return 0.0;
+    }
+    scaled_strength(f, predicted_strength(f, view, s_formula), scale)
+}
+
 /// The strength to use for a warp whose formula asks for `s_formula`: the fraction
 /// of its warp ratio, `ln(1 + s d)`, of least predicted error (see
 /// [`Probe::strength`]), so that the fit degrades continuously to the uniform fit
 /// where the formula's warp does not pay.
-pub(crate) fn predicted_strength(f: &Focus, view: &View, s_formula: f64) -> f64 {
+fn predicted_strength(f: &Focus, view: &View, s_formula: f64) -> f64 {
     if !(s_formula > 0.0) {
         return 0.0;
     }
@@ -608,6 +617,26 @@ pub(crate) mod tests {
             fits(1.0)[0],
             lispsm(&camera, light, &scene, &LispsmOptions::default()).map(|s| s.transform)
         );
+    }
+
+    /// At scale 0 every strength scales to the uniform fit's, exactly: what lets
+    /// `chosen_strength` skip the prediction there.
+    #[test]
+    fn scale_zero_is_the_uniform_strength_whatever_the_prediction() {
+        let (_, camera, scene) = overhead_view();
+        for light in [
+            Vec3::NEG_Y,
+            Vec3::new(0.3, -1.0, 0.6),
+            Vec3::new(1.0, -0.05, 0.0),
+        ] {
+            let body = FocusBody::new(&camera, light, &scene).unwrap();
+            for s in [0.0, 1e-9, 0.01, 3.0, 1e12, f64::MAX] {
+                assert_eq!(scaled_strength(&body.focus, s, 0.0), 0.0, "{s}");
+            }
+            let o = LispsmOptions::default();
+            let (s, _) = warp_strength(&body.focus, &body.view, &o);
+            assert_eq!(chosen_strength(&body.focus, &body.view, s, 0.0), 0.0);
+        }
     }
 
     #[test]

@@ -6,7 +6,7 @@ use shadowmap_frustum::{Camera, MAX_BODY_VERTICES, ShadowTransform};
 
 use crate::FocusBody;
 use crate::focus::{Focus, View};
-use crate::lispsm::{predicted_strength, scaled_strength, warp_fit};
+use crate::lispsm::{chosen_strength, warp_fit};
 use crate::{MAX_WARP_RATIO, WarpError};
 use crate::{ParallelFade, SceneBounds};
 
@@ -29,7 +29,7 @@ pub struct TsmOptions {
     /// the uniform fit with focusing). For a renderer that measures the fit on its
     /// own view samples and backs off where the prediction, made on the receivers'
     /// box, misjudges what the eye sees (`shadowmap::fit` does, given the eye's
-    /// samples).
+    /// samples). At 0 the prediction, most of the fit's time, is skipped.
     pub strength_scale: f32,
 }
 
@@ -196,8 +196,7 @@ fn tsm_body(view: &View, f: &Focus, options: &TsmOptions) -> Result<TsmShadow, W
         s = s.min((MAX_WARP_RATIO - 1.0) / lambda);
     }
     let s = if s.is_finite() { s * fade } else { 0.0 };
-    let s = predicted_strength(f, view, s);
-    let s = scaled_strength(f, s, options.strength_scale);
+    let s = chosen_strength(f, view, s, options.strength_scale);
     let (transform, s) = warp_fit(f, view, s, options.reversed_z)?;
     Ok(TsmShadow {
         transform,

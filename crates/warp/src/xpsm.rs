@@ -38,7 +38,7 @@ pub struct XpsmOptions {
     /// the orthographic fit with focusing). For a renderer that measures the fit on its
     /// own view samples and backs off where the prediction, made on the receivers'
     /// box, misjudges what the eye sees (`shadowmap::fit` does, given the eye's
-    /// samples).
+    /// samples). At 0 the prediction, most of the fit's time, is skipped.
     pub strength_scale: f32,
 }
 
@@ -274,7 +274,12 @@ fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow
         Some(_) => (0.0, 0.0),
         None => {
             let (length, shift) = auto_length(f, view, weight);
-            (predicted_length(view, f, options, length, shift), shift)
+            // Scaled to 0 below whatever the prediction: skip it.
+            if options.strength_scale > 0.0 {
+                (predicted_length(view, f, options, length, shift), shift)
+            } else {
+                (length, shift)
+            }
         }
     };
     let length_p = scaled_strength(f, length_p, options.strength_scale);
