@@ -38,9 +38,11 @@ pub fn auto_candidates(plan: &CascadePlan) -> [Technique; AUTO_CANDIDATE_COUNT] 
 /// frame's): over the quality report's random sweep 512 choose as well as 1024 or
 /// 4096 (no view more than 1.08 times the best), in about 0.35 ms for the seven
 /// candidates (one derivative of each matrix per sample). With the tight cascades'
-/// count measured on the same samples, `auto` on a 160 x 90 G-buffer's samples
-/// takes about 0.73 ms a frame in all (`cargo bench --bench fit_state`:
-/// `auto_on_samples`, 250 times the uniform fit).
+/// count and the warps' strengths measured on the same samples, `auto` on a 160 x
+/// 90 G-buffer's samples takes about 1.4 ms a frame in all (`cargo bench --bench
+/// fit_state`: `auto_on_samples`, 455 times the uniform fit; 0.8 ms with the warps
+/// at their predicted strength only, which measured 1.2 times the best technique
+/// over a fence at seed 14).
 pub const AUTO_MAX_SAMPLES: usize = 512;
 
 /// `auto`: fits every candidate, ranks them by their 95th-percentile aliasing error,
@@ -67,24 +69,16 @@ pub(crate) fn fit_auto(
     let candidates = auto_candidates(plan);
     let mut fitted: [Option<Shadow>; AUTO_CANDIDATE_COUNT] = Default::default();
     let mut tight_fitted = false;
-    // The warps are fitted at their predicted strength only: `auto` measures every
-    // candidate on the samples anyway, the uniform fit among them, so a warp that
-    // the samples would back off is not chosen (their own backing off would fit
-    // each warp three times and measure it three times more).
-    let unsampled = FitInput {
-        eye_samples: None,
-        ..*input
-    };
+    // The warps back off on the samples as they do alone (half their warp ratio,
+    // or none): fitted at their predicted strength only, a warp the samples would
+    // back off half way is not among the candidates, and `auto` measured 1.2 times
+    // TSM (which did) over a fence at seed 14.
     for (slot, technique) in fitted.iter_mut().zip(&candidates) {
         // The stable cascades' count is predicted by the same tight fits as the
         // tight cascades': fitted after them, they keep the count just chosen.
         let count = match technique {
             Technique::StableCascades(_) if tight_fitted => CountChoice::Keep,
             _ => CountChoice::Predict,
-        };
-        let input = match technique {
-            Technique::Lispsm(_) | Technique::Xpsm(_) | Technique::Tsm(_) => &unsampled,
-            _ => input,
         };
         *slot = fit_candidate_with(technique, input, state, count).ok();
         if matches!(technique, Technique::TightCascades(_)) {

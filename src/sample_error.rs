@@ -66,6 +66,20 @@ pub(crate) fn sample_error(
     light: LightDirection,
     percentile: f64,
 ) -> Option<f64> {
+    let mut errors = ArrayVec::new();
+    sample_errors(mapping, texels, samples, light, &mut errors);
+    percentile_of(&mut errors, percentile)
+}
+
+/// The errors `m` that [`sample_error`] takes its percentile of, into `errors`
+/// (cleared first): one per sample `mapping` covers, in the samples' order.
+pub(crate) fn sample_errors(
+    mapping: &dyn ShadowMapping,
+    texels: f64,
+    samples: &Samples<'_>,
+    light: LightDirection,
+    errors: &mut ArrayVec<f64, MAX_SAMPLES>,
+) {
     let probe = Probe {
         steps: PixelSteps::new(samples.camera),
         pixels_per_radian: f64::from(samples.pixels_per_radian),
@@ -74,14 +88,29 @@ pub(crate) fn sample_error(
     };
     let most = samples.most.clamp(1, MAX_SAMPLES);
     let stride = samples.samples.len().div_ceil(most).max(1);
-    let mut errors: ArrayVec<f64, MAX_SAMPLES> = samples
-        .samples
-        .iter()
-        .step_by(stride)
-        .filter_map(|s| probe.error(mapping, texels, s))
-        .take(most)
-        .collect();
-    percentile_of(&mut errors, percentile)
+    errors.clear();
+    errors.extend(
+        samples
+            .samples
+            .iter()
+            .step_by(stride)
+            .filter_map(|s| probe.error(mapping, texels, s))
+            .take(most),
+    );
+}
+
+/// Whether the `percentile` of the population `errors` were drawn from lies at or
+/// below `threshold` beyond the sampling noise of the count above it: at most a
+/// share `1 - percentile` of the errors exceed it by one standard deviation of that
+/// count (`sqrt(n p (1 - p))`, binomial) or more. Where a candidate's errors have a
+/// knee near the percentile (a few percent of the pixels, a wall seen at a grazing
+/// angle, far coarser than the rest), a subset's percentile lands on either side of
+/// the knee by chance; a choice made on it is then a coin toss, and this says so.
+pub(crate) fn confidently_at_most(errors: &[f64], threshold: f64, percentile: f64) -> bool {
+    let n = errors.len() as f64;
+    let above = errors.iter().filter(|e| **e > threshold).count() as f64;
+    let tail = 1.0 - percentile;
+    n > 0.0 && above <= n * tail - math::sqrt(n * tail * percentile)
 }
 
 /// What [`sample_error`] measures a sample with.
@@ -156,5 +185,35 @@ mod tests {
         assert_eq!(error(&behind_the_eye, 1024.0), None);
         let turned_away = [sample(Vec3::new(0.0, 0.0, -10.0), Vec3::NEG_Y)];
         assert!(error(&turned_away, 1024.0).is_some_and(f64::is_finite));
+    }
+
+    /// A percentile below a threshold by a clear share of the samples is confident;
+    /// one whose count above it is within the count's noise of the percentile's
+    /// share is not, though the sample's own percentile lies below it (the knee of
+    /// a subset of 239 samples, ten of them coarse).
+    #[test]
+    fn confidence_needs_the_count_above_the_threshold_clear_of_its_noise() {
+        let knee = |coarse: usize| -> Vec<f64> {
+            (0..239)
+                .map(|i| {
+                    if i < coarse {
+                        6.0
+                    } else {
+                        3.0 + i as f64 * 1e-3
+                    }
+                })
+                .collect()
+        };
+        let mut ten = knee(10);
+        // 10 of 239 above 4.0: the sample's 95th percentile is below it...
+        assert!(percentile_of(&mut ten, 0.95).unwrap() < 4.0);
+        // ... but 10 is within one standard deviation (3.4) of 5% (12).
+        assert!(!confidently_at_most(&ten, 4.0, 0.95));
+        // Two above it are clear of the noise; none at all, of course.
+        assert!(confidently_at_most(&knee(2), 4.0, 0.95));
+        assert!(confidently_at_most(&knee(0), 4.0, 0.95));
+        // Past the threshold, or with no samples: not at most.
+        assert!(!confidently_at_most(&knee(0), 2.0, 0.95));
+        assert!(!confidently_at_most(&[], 4.0, 0.95));
     }
 }
