@@ -4,9 +4,9 @@
 use arrayvec::ArrayVec;
 use glam::{DVec2, DVec3, Vec3};
 use shadowmap_frustum::{
-    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, Light,
-    LightDirection, MAX_CASCADES, MAX_PREDICT_CANDIDATES, ShadowMapping, ShadowSample, SplitScheme,
-    ValidCamera,
+    Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, HeldDepthRange,
+    Light, LightDirection, MAX_CASCADES, MAX_PREDICT_CANDIDATES, ShadowMapping, ShadowSample,
+    SplitScheme, ValidCamera,
 };
 use shadowmap_warp::{LispsmOptions, WarpedCascades, light_frame, warped_cascades};
 
@@ -40,6 +40,14 @@ pub(crate) fn fit_cascades(
     choice: CountChoice,
 ) -> Result<(Fitted, u32), FitError> {
     let camera = ValidCamera::new(input.camera)?;
+    let (near, far) = depth_range(input, &camera);
+    // The stable cascades split a held range, so that their slices and sizes do not
+    // follow every jump of the depth bounds.
+    let range = if stable {
+        state.hold_depth_range(near, far, camera.depth_range())
+    } else {
+        bounds_only(near, far)
+    };
     let mut count = state.count();
     // Each count is predicted as it would be fitted: the stable cascades from a copy
     // of the held maps, so the prediction leaves `state` as it found it.
@@ -55,7 +63,7 @@ pub(crate) fn fit_cascades(
         };
         Some(Candidate::Cascades(set))
     };
-    let splits = choose_splits(plan, input, &camera, &mut count, &candidate, choice)?;
+    let splits = choose_splits(plan, input, range, &mut count, &candidate, choice)?;
     state.set_count(count);
     let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
     let fit = cascade_options(input, layers, direction)?
@@ -100,7 +108,10 @@ pub(crate) fn fit_warped(
     let splits = choose_splits(
         plan,
         input,
-        &camera,
+        {
+            let (near, far) = depth_range(input, &camera);
+            bounds_only(near, far)
+        },
         &mut count,
         &warped,
         CountChoice::Predict,
@@ -225,9 +236,27 @@ impl ShadowMapping for Candidate {
     }
 }
 
-/// Splits of a cascaded technique: practical splits of the depth bounds (the
-/// camera's range without them), so no cascade covers empty depth, into the count
-/// of least predicted error.
+/// The view-depth range a cascaded technique splits: the depth bounds within the
+/// camera's range, the camera's range without them.
+fn depth_range(input: &FitInput<'_>, camera: &ValidCamera) -> (f32, f32) {
+    match input.depth_bounds {
+        Some(bounds) => bounds.clamped_to_valid(camera),
+        None => camera.depth_range(),
+    }
+}
+
+/// A range that splits and covers `[near, far]`.
+fn bounds_only(near: f32, far: f32) -> HeldDepthRange {
+    HeldDepthRange {
+        split: (near, far),
+        cover: (near, far),
+    }
+}
+
+/// Splits of a cascaded technique: practical splits of `range.split` (the depth
+/// bounds, the camera's range without them, or the range the stable cascades hold
+/// around them), so no cascade covers empty depth, the first and last cascade
+/// extended to `range.cover`, into the count of least predicted error.
 ///
 /// For each count `k` up to `plan.max_cascades` (only those whose map side is a
 /// power of two when there are any: the stable fit's whole-texel motion is exact
@@ -258,15 +287,11 @@ impl ShadowMapping for Candidate {
 fn choose_splits(
     plan: &CascadePlan,
     input: &FitInput<'_>,
-    camera: &ValidCamera,
+    range: HeldDepthRange,
     kept: &mut usize,
     fit: &dyn Fn(&CascadeSplits, u32) -> Option<Candidate>,
     choice: CountChoice,
 ) -> Result<CascadeSplits, FitError> {
-    let (near, far) = match input.depth_bounds {
-        Some(bounds) => bounds.clamped_to_valid(camera),
-        None => camera.depth_range(),
-    };
     let max = plan.max_cascades.clamp(1, MAX_CASCADES);
     let side = |k: usize| input.layer_side(u32::try_from(k).unwrap_or(u32::MAX));
     let any_power = (1..=max).any(|k| side(k).is_power_of_two());
@@ -275,7 +300,13 @@ fn choose_splits(
         lambda: plan.split_lambda,
     };
     let splits_of = |k: usize| -> Result<CascadeSplits, FitError> {
-        Ok(CascadeSplits::new(&scheme, k, near, far)?.with_overlap(plan.overlap)?)
+        let (near, far) = range.split;
+        let splits = CascadeSplits::new(&scheme, k, near, far)?.with_overlap(plan.overlap)?;
+        Ok(if range.cover == range.split {
+            splits
+        } else {
+            splits.with_ends(range.cover.0, range.cover.1)?
+        })
     };
     if choice == CountChoice::Keep && allowed(*kept) {
         return splits_of(*kept);

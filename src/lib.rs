@@ -104,6 +104,10 @@
 //! [`STABLE_HEADROOM`](frustum::STABLE_HEADROOM) and kept while they still cover
 //! the footprint and are at most [`STABLE_SHRINK_RATIO`](frustum::STABLE_SHRINK_RATIO)
 //! times too big, so the maps move by whole texels and shadow edges do not shimmer.
+//! The stable cascades also split a held depth range
+//! ([`CascadeState::hold_depth_range`](frustum::CascadeState::hold_depth_range)):
+//! the depth bounds jump when a receiver enters or leaves the view and creep as the
+//! camera walks, and splits that followed them would re-size the maps.
 //!
 //! `auto` fits every candidate and keeps the lowest 95th-percentile error: measured
 //! on the eye samples when the frame has them (and the image's focal length), as the

@@ -21,7 +21,8 @@ pub enum Technique {
     /// Parallel-split shadow maps (Zhang et al.), stable fit: each map fitted to
     /// slice ∩ receivers with a small margin (a turn of the camera by
     /// `STABLE_TURN` about `+Y`, 3% growth), its extents and orientation held across
-    /// frames with hysteresis ([`fit_with_state`](crate::fit_with_state)), texel
+    /// frames with hysteresis ([`fit_with_state`](crate::fit_with_state)), as are
+    /// the splits (of a depth range held around the depth bounds), texel
     /// snapping: shadow edges do not shimmer, and the map costs the margin over the
     /// tight fit, not the whole slice's bounding sphere (which cost 1.26x here).
     /// Frame as [`Technique::TightCascades`]; the count is the one of least

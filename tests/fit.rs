@@ -391,6 +391,13 @@ fn auto_reports_its_choice_and_keeps_it_with_a_selector() {
 /// The stable cascades of a camera walking and turning down the street, fitted with
 /// one `FitState` threaded through the frames, and the tight cascades of frame 0.
 fn street_walk() -> (Vec<Shadow>, Shadow, Vec<Vec3>) {
+    street_walk_with(|_, bounds| bounds)
+}
+
+/// [`street_walk`] with frame `k`'s depth bounds `bounds_at(k, frame 0's)`.
+fn street_walk_with(
+    bounds_at: impl Fn(usize, DepthBounds) -> DepthBounds,
+) -> (Vec<Shadow>, Shadow, Vec<Vec3>) {
     let (first, scene) = street();
     let light = Light::Directional {
         direction: Vec3::new(0.4, -1.0, 0.3),
@@ -410,7 +417,8 @@ fn street_walk() -> (Vec<Shadow>, Shadow, Vec<Vec3>) {
                 Projection::perspective(1.0, 16.0 / 9.0, 0.5, 300.0),
             )
             .unwrap();
-            let input = FitInput::new(&camera, &light, scene, BUDGET).with_depth_bounds(bounds);
+            let input = FitInput::new(&camera, &light, scene, BUDGET)
+                .with_depth_bounds(bounds.map(|b| bounds_at(k, b)));
             fit_with_state(&Technique::StableCascades(plan), &input, &mut state).unwrap()
         })
         .collect();
@@ -429,13 +437,31 @@ fn cascades(shadow: &Shadow) -> &shadowmap::frustum::CascadeSet {
 #[test]
 fn stable_cascades_with_a_fit_state_hold_their_size_and_move_by_whole_texels() {
     let (stable, _, points) = street_walk();
+    assert_whole_texel_moves(&stable, &points);
+}
+
+/// The depth bounds jump (a near receiver leaves the view) and creep (the far end
+/// recedes as the camera walks): the stable cascades split a held range, so their
+/// maps keep their size and still move by whole texels. Splitting each frame's
+/// bounds re-sized them.
+#[test]
+fn stable_cascades_hold_their_size_while_the_depth_bounds_jump_and_creep() {
+    // Frame 0's bounds reach the far plane; half of it leaves room to recede.
+    let (stable, _, points) = street_walk_with(|k, b| DepthBounds {
+        min: if k >= 2 { b.min * 1.2 } else { b.min },
+        max: 0.5 * b.max * 1.03f32.powi(k as i32),
+    });
+    assert_whole_texel_moves(&stable, &points);
+}
+
+fn assert_whole_texel_moves(stable: &[Shadow], points: &[Vec3]) {
     let side = f64::from(stable[0].layer_side());
     for pair in stable.windows(2) {
         let (a, b) = (cascades(&pair[0]), cascades(&pair[1]));
         assert_eq!(a.cascades.len(), b.cascades.len());
         for (ca, cb) in a.cascades.iter().zip(&b.cascades) {
             assert_eq!(ca.texel_world_size, cb.texel_world_size);
-            for p in &points {
+            for p in points {
                 let (Some(sa), Some(sb)) = (ca.transform.project(*p), cb.transform.project(*p))
                 else {
                     continue;

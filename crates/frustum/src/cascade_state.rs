@@ -24,7 +24,7 @@ pub const STABLE_TURN: f64 = 0.1;
 
 /// Margin of a stable cascade's map over its turned footprint (see
 /// [`STABLE_TURN`]) each time its size is (re)chosen: the footprint may grow by
-/// this factor (the slice's depths follow the depth bounds, the camera walks)
+/// this factor (the camera walks, the held depth range's slices move with it)
 /// before the size has to change. Small, because it is what a stable cascade pays
 /// over the tight fit of the same slice where the camera does not turn.
 pub const STABLE_HEADROOM: f64 = 1.03;
@@ -34,10 +34,34 @@ pub const STABLE_HEADROOM: f64 = 1.03;
 /// covers), so the band is wider on this side.
 pub const STABLE_SHRINK_RATIO: f64 = 1.5;
 
+/// Margin of the depth range a stable cascade set covers (see
+/// [`CascadeState::hold_depth_range`]): each time an end of the range is
+/// (re)chosen it reaches this factor beyond the receivers' depth bound there, and
+/// it is kept while it contains the bound and reaches at most this factor squared
+/// beyond it. The depth bounds jump whenever a receiver enters or leaves the view
+/// (a tree leaving the bottom of the image moves the near bound by a fifth) and
+/// creep as the camera walks (the far bound of a camera gliding over terrain grows
+/// by a few percent a frame), and every split moves with them: without a held
+/// range each frame would re-size the cascades and move their texels by
+/// fractions. The margin extends the first and the last cascade only; the splits
+/// between them divide the bounds as they were when the range was chosen.
+pub const STABLE_DEPTH_MARGIN: f32 = 1.25;
+
 /// Smallest sine of the angle between a held orientation's up vector and the light
 /// for the orientation to be kept (the light has turned by less than 60° since it
 /// was chosen); otherwise the map is re-oriented and re-sized.
 const HELD_UP_MIN_SIN: f64 = 0.5;
+
+/// The view-depth ranges a stable cascade set holds across frames (see
+/// [`CascadeState::hold_depth_range`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HeldDepthRange {
+    /// The range the splits divide (the depth bounds when each end was chosen).
+    pub split: (f32, f32),
+    /// The range the cascades cover: the first cascade from `cover.0`, the last
+    /// to `cover.1`.
+    pub cover: (f32, f32),
+}
 
 /// One stable cascade's held map: its extents in light-space units along the
 /// frame's x and y (zero when unset) and the world up vector that orients the frame
@@ -77,6 +101,9 @@ pub struct CascadeState {
     /// Cascade count of the previous frame (0: none), for callers that keep the
     /// count with hysteresis.
     count: usize,
+    /// Held view-depth ranges: the one the splits divide and the one the cascades
+    /// cover (zero: none).
+    depth_range: HeldDepthRange,
 }
 
 impl CascadeState {
@@ -89,6 +116,10 @@ impl CascadeState {
                 up: Vec3::ZERO,
             }; MAX_CASCADES],
             count: 0,
+            depth_range: HeldDepthRange {
+                split: (0.0, 0.0),
+                cover: (0.0, 0.0),
+            },
         }
     }
 
@@ -101,6 +132,69 @@ impl CascadeState {
     /// Records the cascade count chosen for this frame.
     pub fn set_count(&mut self, count: usize) {
         self.count = count;
+    }
+
+    /// The view-depth ranges of the stable cascades, for receivers between view
+    /// depths `near` and `far` (the depth bounds) and a camera that sees `limits`
+    /// (its near and far planes). Each end is held while the held cover range
+    /// contains its bound and reaches at most [`STABLE_DEPTH_MARGIN`]² beyond it;
+    /// otherwise it is re-chosen: the split range ends at the bound, the cover
+    /// range [`STABLE_DEPTH_MARGIN`] beyond it (within `limits`). Splitting the held
+    /// range keeps the splits, and with them the cascades' sizes, still while the
+    /// bounds jump or creep from one frame to the next; extend the first and the
+    /// last cascade to the cover range ([`CascadeSplits::with_ends`](crate::CascadeSplits::with_ends)).
+    ///
+    /// Bounds outside `limits`, reversed or not finite are clamped to `limits`
+    /// (the camera's own range).
+    ///
+    /// ```
+    /// use shadowmap_frustum::CascadeState;
+    /// let mut state = CascadeState::new();
+    /// let first = state.hold_depth_range(40.0, 600.0, (1.0, 1000.0));
+    /// assert_eq!((first.split, first.cover), ((40.0, 600.0), (32.0, 750.0)));
+    /// // The nearest receiver leaves the view, the farthest recedes a little:
+    /// // the same ranges.
+    /// assert_eq!(state.hold_depth_range(50.0, 700.0, (1.0, 1000.0)), first);
+    /// // A receiver nearer than the margin: a new near end only.
+    /// let nearer = state.hold_depth_range(20.0, 700.0, (1.0, 1000.0));
+    /// assert_eq!((nearer.split, nearer.cover), ((20.0, 600.0), (16.0, 750.0)));
+    /// ```
+    pub fn hold_depth_range(&mut self, near: f32, far: f32, limits: (f32, f32)) -> HeldDepthRange {
+        let clamp = |x: f32| {
+            if x.is_finite() {
+                x.clamp(limits.0, limits.1)
+            } else {
+                limits.1
+            }
+        };
+        let (near, far) = (clamp(near), clamp(far));
+        let (near, far) = (near.min(far), far.max(near));
+        let held = self.depth_range;
+        let (cover_near, cover_far) = held.cover;
+        let wide = STABLE_DEPTH_MARGIN * STABLE_DEPTH_MARGIN;
+        // Each end on its own: a jump at one end moves no end the other one set.
+        let valid = limits.0 <= cover_near && cover_near < cover_far && cover_far <= limits.1;
+        let range = &mut self.depth_range;
+        if !(valid && cover_near <= near && near <= cover_near * wide) {
+            range.split.0 = near;
+            range.cover.0 = clamp(near / STABLE_DEPTH_MARGIN);
+        }
+        if !(valid && far <= cover_far && cover_far <= far * wide) {
+            range.split.1 = far;
+            range.cover.1 = clamp(far * STABLE_DEPTH_MARGIN);
+        }
+        if range.split.0 >= range.split.1 {
+            // A near end re-chosen past a held far end's bound (or the reverse):
+            // both from this frame's bounds.
+            *range = HeldDepthRange {
+                split: (near, far),
+                cover: (
+                    clamp(near / STABLE_DEPTH_MARGIN),
+                    clamp(far * STABLE_DEPTH_MARGIN),
+                ),
+            };
+        }
+        *range
     }
 
     /// Forgets every held size and the count.
@@ -331,6 +425,43 @@ mod tests {
             turned_extent(&corners.iter().copied(), &light, 0.0),
             DVec2::new(5.0, 1.0)
         );
+    }
+
+    #[test]
+    fn the_held_depth_range_rides_out_jumps_and_creep_within_the_camera_range() {
+        let limits = (1.0, 1000.0);
+        let mut state = CascadeState::new();
+        let first = state.hold_depth_range(55.0, 160.0, limits);
+        assert_eq!(first.split, (55.0, 160.0));
+        assert_eq!(first.cover, (44.0, 200.0));
+        // The far bound creeps by 3% a frame, the near one jumps by a fifth: the
+        // same ranges for seven frames.
+        for k in 1..=7 {
+            let near = if k > 2 { 66.0 } else { 55.0 };
+            let far = 160.0 * 1.03f32.powi(k);
+            assert_eq!(state.hold_depth_range(near, far, limits), first, "{k}");
+        }
+        // Past the far margin: a new far end, the near end kept.
+        let r = state.hold_depth_range(55.0, 210.0, limits);
+        assert_eq!((r.split, r.cover), ((55.0, 210.0), (44.0, 262.5)));
+        // Far too wide once the bound has come much nearer: a new far end.
+        let r = state.hold_depth_range(55.0, 100.0, limits);
+        assert_eq!((r.split.1, r.cover.1), (100.0, 125.0));
+        // Whatever the bounds, the ranges nest inside the camera's.
+        for (near, far) in [
+            (f32::NAN, 5.0),
+            (500.0, 20.0),
+            (-3.0, f32::INFINITY),
+            (2000.0, 3000.0),
+            (0.5, 1e9),
+        ] {
+            let r = state.hold_depth_range(near, far, limits);
+            let (c, s) = (r.cover, r.split);
+            assert!(
+                limits.0 <= c.0 && c.0 <= s.0 && s.0 <= s.1 && s.1 <= c.1 && c.1 <= limits.1,
+                "{near} {far} -> {r:?}"
+            );
+        }
     }
 
     #[test]

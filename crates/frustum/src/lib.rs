@@ -114,7 +114,10 @@ pub use body::{ConvexBody, MAX_BODY_VERTICES};
 pub use camera::{Camera, Projection};
 pub use cascade::{Cascade, CascadeFit, CascadeOptions, CascadeSet};
 pub use cascade_fit::fit_cascade;
-pub use cascade_state::{CascadeState, STABLE_HEADROOM, STABLE_SHRINK_RATIO, STABLE_TURN};
+pub use cascade_state::{
+    CascadeState, HeldDepthRange, STABLE_DEPTH_MARGIN, STABLE_HEADROOM, STABLE_SHRINK_RATIO,
+    STABLE_TURN,
+};
 pub use clip::MAX_FRUSTUM_AABB_VERTICES;
 pub use depth_bounds::DepthBounds;
 pub use error::FrustumError;

@@ -136,6 +136,45 @@ impl CascadeSplits {
         })
     }
 
+    /// These splits with the first cascade starting at view depth `near` and the
+    /// last ending at `far`, the splits between them unchanged: how the stable
+    /// cascades cover a held range's margins
+    /// ([`CascadeState::hold_depth_range`](crate::CascadeState::hold_depth_range))
+    /// without moving a split.
+    ///
+    /// ```
+    /// use shadowmap_frustum::{CascadeSplits, SplitScheme};
+    /// let splits = CascadeSplits::new(&SplitScheme::Logarithmic, 2, 10.0, 1000.0)?;
+    /// assert_eq!(splits.depths(), &[10.0, 100.0, 1000.0]);
+    /// let wider = splits.clone().with_ends(8.0, 1250.0)?;
+    /// assert_eq!(wider.depths(), &[8.0, 100.0, 1250.0]);
+    /// // An end past an interior split is refused.
+    /// assert!(splits.with_ends(200.0, 1000.0).is_err());
+    /// # Ok::<(), shadowmap_frustum::FrustumError>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`FrustumError::NonFinite`]; [`FrustumError::InvalidDepthRange`] for
+    /// `near <= 0` or ends that are not strictly outside the interior splits.
+    pub fn with_ends(mut self, near: f32, far: f32) -> Result<Self, FrustumError> {
+        if !(near.is_finite() && far.is_finite()) {
+            return Err(FrustumError::NonFinite);
+        }
+        let last = self.depths.len() - 1;
+        let inner_lo = if last > 1 { self.depths[1] } else { far };
+        let inner_hi = if last > 1 {
+            self.depths[last - 1]
+        } else {
+            near
+        };
+        if near <= 0.0 || near >= inner_lo || far <= inner_hi || far <= near {
+            return Err(FrustumError::InvalidDepthRange { near, far });
+        }
+        self.depths[0] = near;
+        self.depths[last] = far;
+        Ok(self)
+    }
+
     /// These splits with a blend band: the last `overlap` fraction (in `[0, 1)`) of each
     /// cascade's own range is blended with the next cascade.
     ///
