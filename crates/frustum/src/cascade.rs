@@ -1,7 +1,7 @@
 use arrayvec::ArrayVec;
 use glam::{DVec2, DVec3, Mat4, Vec3};
 
-use crate::cascade_fit::Fitter;
+use crate::cascade_fit::{FittedBox, Fitter};
 use crate::cascade_state::CascadeState;
 use crate::mapping::{ShadowSample, ShadowTransform, project_dmat, projective_uv_differentials};
 use crate::split::CascadeBlend;
@@ -288,18 +288,15 @@ impl CascadeSet {
         // Cascades of an earlier fit (a refit) are overwritten where they are: every
         // fit writes every field.
         set.truncate(splits.count());
+        if !fitter.has_scene() {
+            return fill_slices(&fitter, splits, set);
+        }
         for i in 0..splits.count() {
             let (near, far) = splits
                 .cascade_range(i)
                 .ok_or(FrustumError::InvalidCascadeCount)?;
-            // By value, stored in each branch: without scene bounds the fit is
-            // inline and its fields go straight to the set.
-            if fitter.has_scene() {
-                let held = state.as_deref_mut().and_then(|s| s.slot(i));
-                keep(set, i, fitter.fit_or_whole(near, far, held)?)?;
-            } else {
-                keep(set, i, fitter.fit(near, far, None)?)?;
-            }
+            let held = state.as_deref_mut().and_then(|s| s.slot(i));
+            keep(set, i, fitter.fit_or_whole(near, far, held)?)?;
         }
         Ok(())
     }
@@ -325,6 +322,48 @@ impl CascadeSet {
             })
         })
     }
+}
+
+/// The cascades of whole slices (no scene bounds) into `set`. The stable fit's
+/// slices are fitted in two passes, every slice's box first, then every slice's
+/// matrices: each box is a chain of dependent square roots and divisions, and in
+/// two passes the chains of different slices are near enough in the instruction
+/// stream to overlap (a 4-cascade stable refit 0.88x the time of the Bevy
+/// transcription in `cargo bench --bench builders`, the median of seven runs, from
+/// about 1.02x in one pass). The tight box is a few minima and maxima: one pass,
+/// without storing the boxes, measured faster there.
+#[inline(always)]
+fn fill_slices(
+    fitter: &Fitter<'_>,
+    splits: &CascadeSplits,
+    set: &mut ArrayVec<Cascade, MAX_CASCADES>,
+) -> Result<(), FrustumError> {
+    let range = |i: usize| -> Result<(f64, f64), FrustumError> {
+        let (near, far) = splits
+            .cascade_range(i)
+            .ok_or(FrustumError::InvalidCascadeCount)?;
+        fitter.check_slice(near, far)
+    };
+    if !fitter.is_stable() {
+        for i in 0..splits.count() {
+            let (n, f) = range(i)?;
+            // By value: inline, its fields go straight to the set.
+            keep(set, i, fitter.fit_slice(n, f, None)?)?;
+        }
+        return Ok(());
+    }
+    let mut boxes = ArrayVec::<(f64, f64, FittedBox), MAX_CASCADES>::new();
+    for i in 0..splits.count() {
+        let (n, f) = range(i)?;
+        let b = fitter.slice_box(n, f)?;
+        boxes
+            .try_push((n, f, b))
+            .map_err(|_| FrustumError::InvalidCascadeCount)?;
+    }
+    for (i, (n, f, b)) in boxes.iter().enumerate() {
+        keep(set, i, fitter.finish_slice(*n, *f, b, None)?)?;
+    }
+    Ok(())
 }
 
 /// Stores cascade `i` of a set being fitted: over the one an earlier fit left there,

@@ -87,7 +87,7 @@ impl<'a> Fitter<'a> {
         (light_dir, scene): (DVec3, Option<SceneBounds>),
         options: &CascadeOptions,
     ) -> Self {
-        let light_from_world = crate::projection::light_rotation(light_dir, options.up_hint);
+        let light_from_world = crate::projection::light_rotation_inline(light_dir, options.up_hint);
         let view = &camera.world_from_view;
         Self {
             camera,
@@ -108,6 +108,18 @@ impl<'a> Fitter<'a> {
             options: *options,
             scene,
         }
+    }
+
+    /// The view depths `[near, far]` checked against the camera's range, in `f64`.
+    #[inline(always)]
+    pub(crate) fn check_slice(&self, near: f32, far: f32) -> Result<(f64, f64), FrustumError> {
+        self.camera.check_slice(near, far)
+    }
+
+    /// Whether the fit is the stable one.
+    #[inline(always)]
+    pub(crate) fn is_stable(&self) -> bool {
+        self.options.fit == CascadeFit::Stable
     }
 
     /// Whether the fit has scene bounds.
@@ -174,11 +186,24 @@ impl<'a> Fitter<'a> {
     }
 
     /// The whole slice `[n, f]`: the light-space box of its corners (tight) or of
-    /// its bounding sphere (stable), its near plane pulled back to `casters`. Inline
-    /// with [`Fitter::finish`]: the fit of a set without scene bounds is this, once
-    /// per slice, and calls cost more than its steps.
+    /// its bounding sphere (stable), its near plane pulled back to `casters`.
     #[inline(always)]
-    fn fit_slice(&self, n: f64, f: f64, casters: Option<&Aabb>) -> Result<Cascade, FrustumError> {
+    pub(crate) fn fit_slice(
+        &self,
+        n: f64,
+        f: f64,
+        casters: Option<&Aabb>,
+    ) -> Result<Cascade, FrustumError> {
+        let fitted = self.slice_box(n, f)?;
+        self.finish_slice(n, f, &fitted, casters)
+    }
+
+    /// The light-space box of the whole slice `[n, f]`: of its corners (tight) or
+    /// of its bounding sphere (stable). Inline: the fit of a set without scene
+    /// bounds is this and [`Fitter::finish_slice`] once per slice, and calls cost
+    /// more than their steps.
+    #[inline(always)]
+    pub(crate) fn slice_box(&self, n: f64, f: f64) -> Result<FittedBox, FrustumError> {
         let res = f64::from(self.options.resolution);
         let (xy_lo, xy_hi, texel, z) = match self.options.fit {
             CascadeFit::Stable => {
@@ -194,19 +219,31 @@ impl<'a> Fitter<'a> {
                 (a, b, texel, (lo.z, hi.z))
             }
         };
-        let fitted = FittedBox {
+        Ok(FittedBox {
             xy_lo,
             xy_hi,
             texel,
             depth: (-z.1, -z.0),
             // The slice's corners, read only if the invertibility test needs them.
             reach: None,
-        };
+        })
+    }
+
+    /// The cascade of the whole slice `[n, f]` in the fitter's light frame for its
+    /// box `fitted` ([`Fitter::slice_box`]), near plane pulled back to `casters`.
+    #[inline(always)]
+    pub(crate) fn finish_slice(
+        &self,
+        n: f64,
+        f: f64,
+        fitted: &FittedBox,
+        casters: Option<&Aabb>,
+    ) -> Result<Cascade, FrustumError> {
         let frame = Frame {
             light_from_world: &self.light_from_world,
             light_from_world32: &self.light_from_world32,
         };
-        self.finish(n, f, &frame, &fitted, casters)
+        self.finish(n, f, &frame, fitted, casters)
     }
 
     /// The slice `[n, f]` ∩ receivers: held across frames ([`Fitter::fit_held`]),
@@ -418,7 +455,7 @@ struct Frame<'m> {
 }
 
 /// A cascade's fitted light-space rectangle and depth range, before the casters.
-struct FittedBox {
+pub(crate) struct FittedBox {
     xy_lo: DVec2,
     xy_hi: DVec2,
     /// World size of one texel (the larger side).

@@ -175,6 +175,13 @@ pub fn least_aligned_axis(dir: DVec3) -> DVec3 {
 /// arguments, so frames built from it are stable as the camera moves.
 #[must_use]
 pub fn light_rotation(dir: DVec3, up_hint: Vec3) -> DMat4 {
+    light_rotation_inline(dir, up_hint)
+}
+
+/// [`light_rotation`], inline where a fit builds its frame once per call: returned
+/// from a call, the frame reaches the fit through memory.
+#[inline(always)]
+pub(crate) fn light_rotation_inline(dir: DVec3, up_hint: Vec3) -> DMat4 {
     // `look_to`'s side axis is `dir × up` normalized, whatever the hint's length: it
     // is taken from the hint as given, normalized once. The hint orients the frame
     // where `|dir × up| > 1e-3 |up|` (the sine of their angle), compared squared; an
