@@ -9,8 +9,13 @@ use crate::{FrustumError, MAX_CASCADES, math};
 /// stable cascade's map absorbs without re-sizing: each time a size is (re)chosen,
 /// the map covers the light-space footprint of slice ∩ receivers turned about the
 /// light by up to `STABLE_TURN * |l · Y|` either way (`l` the light direction),
-/// the part of a turn about `Y` that turns the footprint in the light's plane
-/// (the rest moves it, which the snapped map follows by whole texels). 0.1 rad
+/// the part of a turn about `Y` that is a rotation about the light. For the map's
+/// side along the light's azimuth this is the growth a turn of the ground by
+/// `STABLE_TURN` gives; across it, a turn gives more under a low light (there the
+/// ground along the azimuth, foreshortened by `sin e` in the map at elevation `e`,
+/// swings across unshortened), and a turn of a few degrees can re-size a map
+/// once. Covering that too cost one map 1.13 to 1.27 times the uniform fit in
+/// rooms and under low suns. 0.1 rad
 /// (about 5.7°) covers a camera that turns a few degrees while it walks; a map
 /// that must cover its footprint in every orientation (the bounding sphere of the
 /// slice, Zhang et al.'s stable fit) costs up to 1.41 times the tight fit on
@@ -90,6 +95,11 @@ struct HeldMap {
 /// held box spends its texels on the visible receivers, and its orientation is the
 /// one that fits them when it is chosen rather than one fixed in the world (a
 /// footprint at 45° to a world-fixed frame needs a box up to 1.41 times larger).
+///
+/// The held sizes stay only while the slices stay: split a depth range held by
+/// [`CascadeState::hold_depth_range`] (and extend the end cascades with
+/// [`CascadeSplits::with_ends`](crate::CascadeSplits::with_ends)), not each frame's
+/// depth bounds, which jump when a receiver enters or leaves the view.
 ///
 /// A fresh state (`Default`) holds nothing: the first frame sizes every cascade.
 /// Use one state per light and view; a changed light direction or resolution
