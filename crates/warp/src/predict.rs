@@ -93,16 +93,60 @@ const MAX_POINTS: usize = COLUMNS * ROWS * DEPTHS;
 /// receivers' box faces they lie on, weighted by how front-lit those faces are, and
 /// `perspective` at the same places facing the bisector of the eye and light
 /// directions, at their whole weight (the error of the parameterization alone,
-/// which needs no lit surface).
+/// which needs no lit surface). The second set is needed only where few faces are
+/// front-lit ([`Probe::confidence`] below 1), so it is filled on first use from the
+/// rays kept in `rays`.
 #[derive(Clone, Debug)]
 pub(crate) struct Probe {
     points: ArrayVec<Point, MAX_POINTS>,
     perspective: ArrayVec<Point, MAX_POINTS>,
+    /// Whether `perspective` holds its points.
+    perspective_filled: bool,
     /// The weight the points would carry if every surface were front-lit.
     geometric: f64,
+    /// What the rays were cast from, for the `perspective` pass.
+    rays: Option<Rays>,
+}
+
+/// What a probe's rays are cast from: the screen, the receivers' box, the screen
+/// step and the light.
+#[derive(Clone, Debug)]
+struct Rays {
+    screen: Screen,
+    receivers: Bounds,
+    step: DVec2,
+    light: DVec3,
+}
+
+impl Rays {
+    /// Adds the points of `pass` of every ray to `out`; returns the sum of the rays'
+    /// weights.
+    fn cast(&self, pass: Pass, out: &mut ArrayVec<Point, MAX_POINTS>) -> f64 {
+        let mut geometric = 0.0;
+        for row in 0..ROWS {
+            for column in 0..COLUMNS {
+                let at = DVec2::new(
+                    (column as f64 + 0.5) / COLUMNS as f64,
+                    (row as f64 + 0.5) / ROWS as f64,
+                );
+                geometric += ray_points(self, at, pass, out);
+            }
+        }
+        geometric
+    }
+}
+
+/// Which of a probe's two point sets a pass over the rays adds to.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Pass {
+    /// Face points with the faces' normals and lit weights, and the volume points.
+    Lit,
+    /// The same places facing the bisector of the eye and light directions.
+    Perspective,
 }
 
 /// The view frustum as a screen: rays by normalized position, `(0, 0)` bottom left.
+#[derive(Clone, Debug)]
 struct Screen {
     near: [DVec3; 4],
     far: [DVec3; 4],
@@ -141,11 +185,14 @@ impl Probe {
         Self {
             points: ArrayVec::new_const(),
             perspective: ArrayVec::new_const(),
+            perspective_filled: false,
             geometric: 0.0,
+            rays: None,
         }
     }
 
-    /// Adds the probe points of `f` seen from `view`.
+    /// Adds the probe points of `f` seen from `view` (the face-normal set; the
+    /// perspective set waits for [`Probe::strength`] to need it).
     pub(crate) fn fill(&mut self, view: &View, f: &Focus) {
         let c = view.frustum.corners.map(glam::Vec3::as_dvec3);
         let screen = Screen {
@@ -156,19 +203,27 @@ impl Probe {
         };
         let aspect = (c[1] - c[0]).length() / (c[3] - c[0]).length();
         let step = DVec2::new(STEP / aspect.max(1e-12), STEP);
-        let mut b = Bounds::EMPTY;
+        let mut receivers = Bounds::EMPTY;
         for p in &f.receivers {
-            b.add(*p);
+            receivers.add(*p);
         }
-        for row in 0..ROWS {
-            for column in 0..COLUMNS {
-                let at = DVec2::new(
-                    (column as f64 + 0.5) / COLUMNS as f64,
-                    (row as f64 + 0.5) / ROWS as f64,
-                );
-                let out = (&mut self.points, &mut self.perspective);
-                self.geometric += ray_points(&screen, &b, at, step, f.light, out);
+        let rays = Rays {
+            screen,
+            receivers,
+            step,
+            light: f.light,
+        };
+        self.geometric += rays.cast(Pass::Lit, &mut self.points);
+        self.rays = Some(rays);
+    }
+
+    /// Fills the perspective set, once.
+    fn fill_perspective(&mut self) {
+        if !self.perspective_filled {
+            if let Some(rays) = &self.rays {
+                rays.cast(Pass::Perspective, &mut self.perspective);
             }
+            self.perspective_filled = true;
         }
     }
 
@@ -193,7 +248,7 @@ impl Probe {
     /// falling back to the formula instead kept XPSM's length at a fence lit from
     /// 3° above the horizon, predicted 2x the uniform fit's error and measured 1.57x.
     /// Each fit is computed once for both errors.
-    pub(crate) fn strength(&self, mut clip_at: impl FnMut(f64) -> Option<DMat4>) -> f64 {
+    pub(crate) fn strength(&mut self, mut clip_at: impl FnMut(f64) -> Option<DMat4>) -> f64 {
         let confidence = self.confidence();
         let mut clips: [Option<Option<DMat4>>; GRID] = [None; GRID];
         let mut clip = |t: f64| {
@@ -205,6 +260,7 @@ impl Probe {
         if let (Some(t), true) = (lit, confidence >= 1.0) {
             return t;
         }
+        self.fill_perspective();
         let perspective = choose(|t| clip(t).map_or(f64::INFINITY, |c| self.perspective_error(&c)));
         lit.map_or(perspective, |t| {
             perspective + (t - perspective) * confidence
@@ -268,63 +324,144 @@ fn points_error(points: &[Point], clip_from_world: &DMat4) -> f64 {
 /// facing the bisector of the eye and light directions. Between these cases the
 /// weights blend over a 5% band of depth, and a face's normal over a 2% band near
 /// the box's edges, so every weight and normal is continuous.
-fn ray_points(
-    screen: &Screen,
-    b: &Bounds,
-    at: DVec2,
-    step: DVec2,
-    light: DVec3,
-    (out, perspective): (
-        &mut ArrayVec<Point, MAX_POINTS>,
-        &mut ArrayVec<Point, MAX_POINTS>,
-    ),
-) -> f64 {
-    let ray = screen.ray(at.x, at.y);
-    let (o, d) = (ray.origin, ray.dir);
-    let (mut enter, mut exit) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
-    for axis in 0..3 {
-        if d[axis] == 0.0 {
-            if o[axis] < b.min[axis] || o[axis] > b.max[axis] {
-                return 0.0;
-            }
-            continue;
-        }
-        // Finite bounds and ray, `d != 0`: no NaN for `min_num` and `max_num`.
-        let t0 = (b.min[axis] - o[axis]) / d[axis];
-        let t1 = (b.max[axis] - o[axis]) / d[axis];
-        enter[axis] = min_num(t0, t1);
-        exit[axis] = max_num(t0, t1);
-    }
-    let s_enter = max_num(max_num(enter[0], enter[1]), enter[2]);
-    let s_exit = min_num(min_num(exit[0], exit[1]), exit[2]);
-    let (s0, s1) = (max_num(s_enter, 0.0), min_num(s_exit, 1.0));
-    let (zn, zf) = (screen.depth(o), screen.depth(o + d));
-    let depth = |s: f64| zn + s * (zf - zn);
-    let (z0, z1) = (depth(s0), depth(s1));
-    if !(s0 <= s1 && z0 > 0.0 && z1 >= z0 && zf > zn) {
+fn ray_points(rays: &Rays, at: DVec2, pass: Pass, out: &mut ArrayVec<Point, MAX_POINTS>) -> f64 {
+    let ray = rays.screen.ray(at.x, at.y);
+    let Some(seg) = Segment::new(&ray, &rays.screen, &rays.receivers) else {
         return 0.0;
-    }
-    // Rays that graze the box fade out (the clipped segment shrinks to a point) to
-    // a small floor, which is every ray's weight on a flat box.
-    let ray_weight = log_step(z1 / z0).max(RAY_WEIGHT_FLOOR);
-    let alpha = if s_enter > 0.0 {
-        log_step(z0 / zn)
-    } else {
-        0.0
     };
-    let beta = if s_exit < 1.0 { log_step(zf / z1) } else { 0.0 };
-    let point = |s: f64, n: DVec3, weight: f64| point_at(&ray, step, s, n, weight);
+    let d = ray.dir;
+    let light = rays.light;
+    let point = |s: f64, n: DVec3, weight: f64| point_at(&ray, rays.step, s, n, weight);
+    let mut push = |q: Option<Point>| {
+        if let Some(q) = q.filter(|q| q.weight > 0.0) {
+            let _ = out.try_push(q);
+        }
+    };
     // The bisector of the eye and light directions; where the light comes straight
     // at the viewer it vanishes, and the points facing it fade out.
-    let to_eye = -d.normalize_or_zero();
-    let bisector = to_eye - light;
-    let facing = bisector.length();
-    let (n_bisector, w_bisector) = (bisector / facing, smoothstep(0.0, 0.1, facing));
-    let face = |s_face: f64, slabs: &[f64; 3]| {
-        let mut n = DVec3::ZERO;
-        let depth_face = depth(s_face);
+    let bisector = || {
+        let bisector = -d.normalize_or_zero() - light;
+        let facing = bisector.length();
+        (bisector / facing, smoothstep(0.0, 0.1, facing))
+    };
+    // A face point: on the face with its normal where front-lit (only front-lit
+    // surfaces matter: within about 3° of parallel to the light shading darkens a
+    // surface whatever the map says, and its texels stretch without bound, so such
+    // faces fade out between sin 3° and sin 6°), or facing the bisector.
+    let mut face_point = |s: f64, slabs: &[f64; 3], weight: f64| match pass {
+        Pass::Lit => {
+            let n = seg.face_normal(s, slabs, d);
+            push(point(s, n, weight * smoothstep(0.05, 0.1, -n.dot(light))));
+        }
+        Pass::Perspective => {
+            let (n_bisector, w_bisector) = bisector();
+            push(point(s, n_bisector, weight * w_bisector));
+        }
+    };
+    let (ray_weight, alpha, beta) = (seg.ray_weight, seg.alpha, seg.beta);
+    if alpha > 0.0 {
+        face_point(seg.s0, &seg.enter, ray_weight * alpha);
+    }
+    let w_exit = ray_weight * (1.0 - alpha) * beta;
+    if w_exit > 0.0 {
+        face_point(seg.s1, &seg.exit, w_exit);
+    }
+    let w_segment = ray_weight * (1.0 - alpha) * (1.0 - beta) / DEPTHS as f64;
+    if !(w_segment > 0.0) {
+        return ray_weight;
+    }
+    let (n_bisector, w_bisector) = bisector();
+    let w_volume = w_segment * w_bisector;
+    if !(w_volume > 0.0) {
+        return ray_weight;
+    }
+    // Depths `z0 (z1 / z0)^((k + 1/2) / DEPTHS)`: odd powers of the eighth root.
+    let (z0, z1, zn, zf) = (seg.z0, seg.z1, seg.zn, seg.zf);
+    let root = math::sqrt(math::sqrt(math::sqrt(z1 / z0)));
+    let mut z = z0 * root;
+    for _ in 0..DEPTHS {
+        push(point((z - zn) / (zf - zn), n_bisector, w_volume));
+        z *= root * root;
+    }
+    ray_weight
+}
+
+/// A probe ray's segment inside the receivers' box: its parameters (`s`, 0 at the
+/// near face and 1 at the far face) and view depths, the slabs' entry and exit
+/// parameters, and the weights of [`ray_points`].
+struct Segment {
+    enter: [f64; 3],
+    exit: [f64; 3],
+    s0: f64,
+    s1: f64,
+    zn: f64,
+    zf: f64,
+    z0: f64,
+    z1: f64,
+    /// The ray's weight: rays that graze the box fade out (the clipped segment
+    /// shrinks to a point) to a small floor, which is every ray's weight on a flat
+    /// box.
+    ray_weight: f64,
+    /// The share of the face it enters through (the eye outside the box) ...
+    alpha: f64,
+    /// ... and of the face it leaves through before the far plane.
+    beta: f64,
+}
+
+impl Segment {
+    /// The segment of `ray` in box `b`; `None` where it misses the box.
+    fn new(ray: &Ray, screen: &Screen, b: &Bounds) -> Option<Self> {
+        let (o, d) = (ray.origin, ray.dir);
+        let (mut enter, mut exit) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
         for axis in 0..3 {
-            let apart = (s_face - slabs[axis]).abs() * (zf - zn);
+            if d[axis] == 0.0 {
+                if o[axis] < b.min[axis] || o[axis] > b.max[axis] {
+                    return None;
+                }
+                continue;
+            }
+            // Finite bounds and ray, `d != 0`: no NaN for `min_num` and `max_num`.
+            let t0 = (b.min[axis] - o[axis]) / d[axis];
+            let t1 = (b.max[axis] - o[axis]) / d[axis];
+            enter[axis] = min_num(t0, t1);
+            exit[axis] = max_num(t0, t1);
+        }
+        let s_enter = max_num(max_num(enter[0], enter[1]), enter[2]);
+        let s_exit = min_num(min_num(exit[0], exit[1]), exit[2]);
+        let (s0, s1) = (max_num(s_enter, 0.0), min_num(s_exit, 1.0));
+        let (zn, zf) = (screen.depth(o), screen.depth(o + d));
+        let depth = |s: f64| zn + s * (zf - zn);
+        let (z0, z1) = (depth(s0), depth(s1));
+        if !(s0 <= s1 && z0 > 0.0 && z1 >= z0 && zf > zn) {
+            return None;
+        }
+        Some(Self {
+            enter,
+            exit,
+            s0,
+            s1,
+            zn,
+            zf,
+            z0,
+            z1,
+            ray_weight: log_step(z1 / z0).max(RAY_WEIGHT_FLOOR),
+            alpha: if s_enter > 0.0 {
+                log_step(z0 / zn)
+            } else {
+                0.0
+            },
+            beta: if s_exit < 1.0 { log_step(zf / z1) } else { 0.0 },
+        })
+    }
+
+    /// The normal of the box face at parameter `s_face` (where `slabs` holds the
+    /// slabs' parameters there), blended with its neighbours' within 2% of depth of
+    /// an edge so that it turns continuously; `d` the ray's direction.
+    fn face_normal(&self, s_face: f64, slabs: &[f64; 3], d: DVec3) -> DVec3 {
+        let mut n = DVec3::ZERO;
+        let depth_face = self.zn + s_face * (self.zf - self.zn);
+        for axis in 0..3 {
+            let apart = (s_face - slabs[axis]).abs() * (self.zf - self.zn);
             // Slabs far from this face's (a relative depth above 0.02 by more than
             // rounding) add nothing: skip the division.
             if apart >= FACE_BAND_SATURATED * depth_face {
@@ -336,46 +473,7 @@ fn ray_points(
             n += e * (1.0 - smoothstep(0.0, 0.02, rel));
         }
         n.normalize_or_zero()
-    };
-    let mut push = |q: Option<Point>, bisecting: Option<Point>| {
-        if let Some(q) = q.filter(|q| q.weight > 0.0) {
-            let _ = out.try_push(q);
-        }
-        if let Some(q) = bisecting.filter(|q| q.weight > 0.0) {
-            let _ = perspective.try_push(q);
-        }
-    };
-    // A face point: on the face with its normal where front-lit (only front-lit
-    // surfaces matter: within about 3° of parallel to the light shading darkens a
-    // surface whatever the map says, and its texels stretch without bound, so such
-    // faces fade out between sin 3° and sin 6°), and facing the bisector.
-    let mut face_point = |s: f64, n: DVec3, weight: f64| {
-        let lit = smoothstep(0.05, 0.1, -n.dot(light));
-        push(
-            point(s, n, weight * lit),
-            point(s, n_bisector, weight * w_bisector),
-        );
-    };
-    if alpha > 0.0 {
-        face_point(s0, face(s0, &enter), ray_weight * alpha);
     }
-    let w_exit = ray_weight * (1.0 - alpha) * beta;
-    if w_exit > 0.0 {
-        face_point(s1, face(s1, &exit), w_exit);
-    }
-    let w_volume = ray_weight * (1.0 - alpha) * (1.0 - beta) / DEPTHS as f64 * w_bisector;
-    if !(w_volume > 0.0) {
-        return ray_weight;
-    }
-    // Depths `z0 (z1 / z0)^((k + 1/2) / DEPTHS)`: odd powers of the eighth root.
-    let root = math::sqrt(math::sqrt(math::sqrt(z1 / z0)));
-    let mut z = z0 * root;
-    for _ in 0..DEPTHS {
-        let q = point((z - zn) / (zf - zn), n_bisector, w_volume);
-        push(q, q);
-        z *= root * root;
-    }
-    ray_weight
 }
 
 /// Above this relative depth a slab's face blend is surely 0 (see `ray_points`):
@@ -523,6 +621,7 @@ mod tests {
             }
             probe.geometric += 1.0;
         }
+        probe.perspective_filled = true;
         probe
     }
 
@@ -532,7 +631,7 @@ mod tests {
     #[test]
     fn without_lit_faces_the_perspective_error_chooses() {
         let clip = |t: f64| Some(DMat4::from_scale(DVec3::new(2.0 - t, 2.0 - t, 1.0)));
-        let unlit = probe(0.0);
+        let mut unlit = probe(0.0);
         assert_eq!(unlit.confidence(), 0.0);
         let t = unlit.strength(clip);
         assert!(t < 0.05, "{t}");
@@ -540,7 +639,7 @@ mod tests {
         // and shrinks along x as `t` grows serves them best at `t = 1`, the
         // bisector's plane at `t = 0`.
         let squeeze = |t: f64| Some(DMat4::from_scale(DVec3::new(2.0 - t, 0.5 + t, 1.0)));
-        let lit = probe(1.0);
+        let mut lit = probe(1.0);
         assert_eq!(lit.confidence(), 1.0);
         assert!(lit.strength(squeeze) > 0.95);
         assert!(unlit.strength(squeeze) < 0.5);
