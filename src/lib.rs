@@ -100,10 +100,11 @@
 //! Across frames, [`fit_with_state`] threads a caller-held [`FitState`]: `auto`'s
 //! choice, the cascade counts (kept unless another is clearly better) and each stable
 //! cascade's map extents and orientation, fitted to slice ∩ receivers turned by up
-//! to [`STABLE_TURN`](frustum::STABLE_TURN) with
-//! [`STABLE_HEADROOM`](frustum::STABLE_HEADROOM) and kept while they still cover
-//! the footprint and are at most [`STABLE_SHRINK_RATIO`](frustum::STABLE_SHRINK_RATIO)
-//! times too big, so the maps move by whole texels and shadow edges do not shimmer.
+//! to [`STABLE_TURN`](frustum::STABLE_TURN) (or grown by
+//! [`STABLE_HEADROOM`](frustum::STABLE_HEADROOM) where that is more) and kept
+//! while they still cover the footprint and are at most
+//! [`STABLE_SHRINK_RATIO`](frustum::STABLE_SHRINK_RATIO) times too big, so the
+//! maps move by whole texels and shadow edges do not shimmer.
 //! The stable cascades also split a held depth range
 //! ([`CascadeState::hold_depth_range`](frustum::CascadeState::hold_depth_range)):
 //! the depth bounds jump when a receiver enters or leaves the view and creep as the

@@ -479,14 +479,14 @@ fn stable_cascades_cost_at_most_the_headroom_over_tight_ones() {
     let (stable, tight, _) = street_walk();
     let (s, t) = (cascades(&stable[0]), cascades(&tight));
     assert_eq!(s.cascades.len(), t.cascades.len());
-    // The larger side of a box turned by phi grows by at most cos phi + sin phi; then
-    // the headroom, its short-mantissa rounding and the snap's texel.
+    // The larger side of a box turned by phi grows by at most cos phi + sin phi, or
+    // the headroom where that is more; then the short-mantissa rounding and the
+    // snap's texel.
     let light_y = Vec3::new(0.4, -1.0, 0.3).normalize().y;
     let phi = shadowmap::frustum::STABLE_TURN * f64::from(light_y.abs());
     let side = f64::from(stable[0].layer_side());
-    let bound =
-        (phi.cos() + phi.sin()) * shadowmap::frustum::STABLE_HEADROOM * (1.0 + 1.0 / 64.0) * side
-            / (side - 1.0);
+    let turned = (phi.cos() + phi.sin()).max(shadowmap::frustum::STABLE_HEADROOM);
+    let bound = turned * (1.0 + 1.0 / 64.0) * side / (side - 1.0);
     for (cs, ct) in s.cascades.iter().zip(&t.cascades) {
         let ratio = f64::from(cs.texel_world_size / ct.texel_world_size);
         assert!(

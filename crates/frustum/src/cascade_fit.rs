@@ -332,6 +332,7 @@ impl<'a> Fitter<'a> {
         let points = body.vertices().iter().map(|v| v.as_dvec3());
         let b = held_box(
             &points,
+            &scene.receivers,
             self.light_dir,
             &self.light_from_world,
             f64::from(self.options.resolution),
