@@ -7,8 +7,9 @@
 use arbitrary::Unstructured;
 use glam::{Mat4, Vec3};
 use shadowmap_frustum::{
-    Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, ConvexBody, DepthBounds,
-    Frustum, Light, SceneBounds, SplitScheme, directional_light_from_world, fit_spot,
+    Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, ConvexBody,
+    DepthBounds, Frustum, Light, SceneBounds, SplitScheme, ValidCamera,
+    directional_light_from_world, fit_spot,
 };
 
 /// The crate these generators build values of. `shadowmap-frustum`'s own unit tests
@@ -230,6 +231,13 @@ pub fn check_cascades(case: &CascadeCase) {
         return;
     };
     assert_eq!(set.cascades.len(), case.count);
+    check_cascade_set(&set);
+    check_held_cascades(case, &splits, (near, far));
+}
+
+/// Every cascade of `set` has finite invertible matrices, a positive texel and a
+/// depth range.
+fn check_cascade_set(set: &CascadeSet) {
     for c in &set.cascades {
         assert_invertible(&c.transform.clip_from_world, "cascade clip_from_world");
         assert_invertible(&c.transform.uv_from_world, "cascade uv_from_world");
@@ -241,6 +249,34 @@ pub fn check_cascades(case: &CascadeCase) {
             c.light_depth.0.is_finite() && c.light_depth.1 > c.light_depth.0,
             "{c:?}"
         );
+    }
+}
+
+/// The fit with a held state (`fit_with_state`, the stable fit's held sizes): the
+/// held depth range nests in the camera's, the sets it fits pass
+/// [`check_cascade_set`], and fitting the same frame again keeps every cascade's
+/// texel (a held map re-sized without cause would shimmer).
+fn check_held_cascades(case: &CascadeCase, splits: &CascadeSplits, (near, far): (f32, f32)) {
+    let mut state = CascadeState::new();
+    let range = state.hold_depth_range(near, far, (near, far));
+    for (lo, hi) in [range.split, range.cover] {
+        assert!(
+            near <= lo && lo <= hi && hi <= far,
+            "{range:?} in {near}..{far}"
+        );
+    }
+    let Ok(valid) = ValidCamera::new(&case.camera) else {
+        return;
+    };
+    let mut fit =
+        || CascadeSet::fit_with_state(&valid, case.light, splits, &case.options, &mut state);
+    let Ok(first) = fit() else {
+        return;
+    };
+    check_cascade_set(&first);
+    let again = fit().expect("the frame that fitted fits again");
+    for (a, b) in first.cascades.iter().zip(&again.cascades) {
+        assert_eq!(a.texel_world_size, b.texel_world_size, "{a:?} then {b:?}");
     }
 }
 
