@@ -7,8 +7,8 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use shadowmap::frustum::{Aabb, Camera, DepthBounds, Light, Projection, SceneBounds};
 use shadowmap::paraboloid::{
-    ConeFit, CubeMap, CubeOptions, IpsmOptions, IpsmPlan, MapOptions, ParaboloidMap,
-    fit_minimal_cone, fit_paper_cone,
+    ConeFit, CubeMap, CubeOptions, CubeOrientation, IpsmOptions, IpsmPlan, MapOptions,
+    ParaboloidMap, fit_minimal_cone, fit_paper_cone,
 };
 use std::hint::black_box;
 use std::time::Duration;
@@ -86,8 +86,9 @@ fn plan(c: &mut Criterion) {
 }
 
 /// One cube-map fit per iteration over the same 64 configurations, above a ground
-/// slab with casters: focused and unfocused, and `ParaboloidMap::dual` (a DPSM's
-/// whole per-frame build) in the same group as the reference for the ratio.
+/// slab with casters: focused (the orientation predicted, as by default, and each
+/// orientation alone) and unfocused, and `ParaboloidMap::dual` (a DPSM's whole
+/// per-frame build) in the same group as the reference for the ratio.
 fn cube(c: &mut Criterion) {
     let cases = configs();
     let ground = Aabb::new(
@@ -114,8 +115,19 @@ fn cube(c: &mut Criterion) {
             )
         });
     });
-    for (name, focused) in [("focused", true), ("unfocused", false)] {
-        let options = CubeOptions::default().with_focused(focused);
+    let focused = CubeOptions::default();
+    for (name, options) in [
+        ("focused", focused),
+        (
+            "focused_world_axes",
+            focused.with_orientation(CubeOrientation::WorldAxes),
+        ),
+        (
+            "focused_toward_receivers",
+            focused.with_orientation(CubeOrientation::TowardReceivers),
+        ),
+        ("unfocused", focused.with_focused(false)),
+    ] {
         g.bench_function(name, |b| {
             b.iter(|| {
                 i = (i + 1) % cases.len();

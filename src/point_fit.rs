@@ -8,8 +8,8 @@ use glam::DVec3;
 use shadowmap_frustum::math::sqrt;
 use shadowmap_frustum::{LightDirection, ShadowMapping, ShadowSample};
 use shadowmap_paraboloid::{
-    CubeMap, CubeOptions, FaceSizes, IpsmOptions, IpsmPlan, ParaboloidMap, Side, TileOptions,
-    TiledCube,
+    CubeMap, CubeOptions, CubeOrientation, FaceSizes, IpsmOptions, IpsmPlan, ParaboloidMap, Side,
+    TileOptions, TiledCube,
 };
 use shadowmap_rtw::{
     AxisNeed, BasePoint, EyeSample, ImportanceMap, WarpMaps, oracle_needs, oracle_needs_where,
@@ -40,13 +40,57 @@ fn eye_samples<'a>(
 /// backward analysis misjudges a room's walls, the full warp can lose to the
 /// paraboloid it warps (a lamp beside the eye in a room: 1.16 times the DPSM's
 /// error), and the strength 0 is that paraboloid.
+///
+/// The paraboloid warped is the plan's own map and, where the IPSM techniques keep
+/// a dual alternative instead ([`fit_ipsm`]), that one too; the warp whose front-lit
+/// samples' 95th percentile of `m` is smaller is kept. Neither base wins everywhere:
+/// over wooded terrain the plan's own map started 1.09 times coarser than the DPSM
+/// and no strength made that up, while in a city block the warp of the plan's own
+/// map ended 2.8 times finer than any warp of the dual map.
 pub(crate) fn fit_point_rtw(
     ipsm: &IpsmOptions,
     plan: &RtwPlan,
     input: &FitInput<'_>,
 ) -> Result<Fitted, FitError> {
     let samples = eye_samples(input, "point_rtw")?;
-    let ipsm = IpsmPlan::new(input.light, input.camera, input.depth_bounds, ipsm)?;
+    let own = IpsmPlan::new(input.light, input.camera, input.depth_bounds, ipsm)?;
+    let warped_own = warp_paraboloid(own, plan, input, samples)?;
+    let kept = fit_ipsm(ipsm, input)?;
+    let Some(ppr) = input.pixels_per_radian.filter(|_| kept.map != own.map) else {
+        return Ok(warped_own);
+    };
+    let warped_kept = warp_paraboloid(kept, plan, input, samples)?;
+    let error = |fitted: &Fitted| {
+        let Fitted::PointRtw { plan, front, back } = fitted else {
+            return f64::INFINITY;
+        };
+        let mapping = WarpedParaboloid {
+            map: &plan.map,
+            front,
+            back: back.as_ref(),
+        };
+        let side = f64::from(layer_side(input.texel_budget, plan.map.layers()));
+        let measured = Samples {
+            unlit: Unlit::Skipped,
+            ..Samples::new(input.camera, ppr, samples)
+        };
+        let light = LightDirection::Position(plan.map.position);
+        sample_error(&mapping, side, &measured, light, NEED_PERCENTILE).unwrap_or(f64::INFINITY)
+    };
+    Ok(if error(&warped_kept) < error(&warped_own) {
+        warped_kept
+    } else {
+        warped_own
+    })
+}
+
+/// RTW's tables over each side of `ipsm`'s map (see [`fit_point_rtw`]).
+fn warp_paraboloid(
+    ipsm: IpsmPlan,
+    plan: &RtwPlan,
+    input: &FitInput<'_>,
+    samples: &[EyeSample],
+) -> Result<Fitted, FitError> {
     let map = ipsm.map;
     let n = plan.importance_side;
     let side_warps = |side: Side| -> Result<WarpMaps, FitError> {
@@ -86,6 +130,22 @@ pub(crate) fn fit_point_rtw(
         front,
         back,
     })
+}
+
+/// Both sides of a paraboloid map, each warped by its tables: what
+/// [`fit_point_rtw`] measures a base's warp on.
+struct WarpedParaboloid<'a> {
+    map: &'a ParaboloidMap,
+    front: &'a WarpMaps,
+    back: Option<&'a WarpMaps>,
+}
+
+impl ShadowMapping for WarpedParaboloid<'_> {
+    fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
+        let s = self.map.map_point(world)?;
+        let warps = if s.layer == 0 { self.front } else { self.back? };
+        warps.warp_sample(s)
+    }
 }
 
 /// One side of a paraboloid map warped by `warps`: what [`fit_point_rtw`] measures
@@ -155,48 +215,99 @@ pub(crate) fn fit_ipsm(options: &IpsmOptions, input: &FitInput<'_>) -> Result<Ip
 /// percentile over the view, not each face's own. Equal errors per face would let
 /// a face that a few pixels see at a grazing angle (a wall beside a lamp) take
 /// most of the budget from the faces most pixels see.
+///
+/// With [`CubeOrientation::Predicted`] both orientations are fitted and sized this
+/// way and the one whose samples' 95th percentile of `m` is smaller is kept: the
+/// prediction on the receivers' box misjudges some rooms (it turned a cube that then
+/// measured 2.2 times the world-axis cube's error), the samples do not.
 pub(crate) fn fit_cube(options: &CubeOptions, input: &FitInput<'_>) -> Result<CubeMap, FitError> {
-    let mut cube = fit_faces(options, input)?;
-    if let (FaceSizes::ByNeed, Some(samples), Some(ppr)) =
+    let (FaceSizes::ByNeed, Some(samples), Some(ppr)) =
         (options.sizes, input.eye_samples, input.pixels_per_radian)
-    {
-        // At most `MAX_SAMPLES` of them, the front-lit ones (the others are dark
-        // whatever the map holds), each measured on the face that stores it; no
-        // allocation per frame.
-        let stride = samples.len().div_ceil(MAX_SAMPLES).max(1);
-        let light = LightDirection::Position(cube.position);
-        let mut needs: ArrayVec<(usize, f64), MAX_SAMPLES> = ArrayVec::new();
-        for layer in 0..cube.layers() {
-            let Some(base) = cube.transform(layer) else {
-                continue;
-            };
-            let stored = |i: usize, s: &EyeSample| {
-                i % stride == 0
-                    && is_front_lit(s, light)
-                    && cube
-                        .map_point(s.position.as_dvec3())
-                        .is_some_and(|x| x.layer == layer)
-            };
-            oracle_needs_where(&base, input.camera, ppr, samples, stored, |_, need| {
+    else {
+        return fit_faces(options, input);
+    };
+    let orientations: &[CubeOrientation] = match options.orientation {
+        CubeOrientation::Predicted => {
+            &[CubeOrientation::WorldAxes, CubeOrientation::TowardReceivers]
+        }
+        ref o => core::slice::from_ref(o),
+    };
+    let mut best: Option<(f64, CubeMap)> = None;
+    for o in orientations {
+        let mut cube = fit_faces(&options.with_orientation(*o), input)?;
+        if best
+            .as_ref()
+            .is_some_and(|(_, b)| b.orientation() == cube.orientation())
+        {
+            continue;
+        }
+        let error = size_by_samples(&mut cube, input, samples, ppr)?.unwrap_or(f64::INFINITY);
+        if best.as_ref().is_none_or(|(e, _)| error < *e) {
+            best = Some((error, cube));
+        }
+    }
+    match best {
+        Some((_, cube)) => Ok(cube),
+        None => fit_faces(options, input),
+    }
+}
+
+/// Sizes the faces of `cube` by the needs of the eye samples they store (see
+/// [`fit_cube`]); returns the [`NEED_PERCENTILE`] of the samples' `m` on the sized
+/// faces, `None` (sizes unchanged) without a need.
+fn size_by_samples(
+    cube: &mut CubeMap,
+    input: &FitInput<'_>,
+    samples: &[EyeSample],
+    pixels_per_radian: f32,
+) -> Result<Option<f64>, FitError> {
+    // At most `MAX_SAMPLES` of them, the front-lit ones (the others are dark
+    // whatever the map holds), each measured on the face that stores it; no
+    // allocation per frame.
+    let stride = samples.len().div_ceil(MAX_SAMPLES).max(1);
+    let light = LightDirection::Position(cube.position);
+    let mut needs: ArrayVec<(usize, f64), MAX_SAMPLES> = ArrayVec::new();
+    for layer in 0..cube.layers() {
+        let Some(base) = cube.transform(layer) else {
+            continue;
+        };
+        let stored = |i: usize, s: &EyeSample| {
+            i % stride == 0
+                && is_front_lit(s, light)
+                && cube
+                    .map_point(s.position.as_dvec3())
+                    .is_some_and(|x| x.layer == layer)
+        };
+        oracle_needs_where(
+            &base,
+            input.camera,
+            pixels_per_radian,
+            samples,
+            stored,
+            |_, need| {
                 if need.isotropic.is_finite() && need.isotropic > 0.0 {
                     let _ = needs.try_push((layer as usize, need.isotropic));
                 }
-            })?;
-        }
-        let densities = face_densities(&mut needs, cube.faces.len());
-        let by_need: ArrayVec<Option<[f64; 2]>, 6> = densities
-            .iter()
-            .map(|&d| (d > 0.0).then_some([d, d]))
-            .collect();
-        if by_need.iter().any(Option::is_some) {
-            cube.set_sizes_by_need_with_floor(
-                &by_need,
-                input.texel_budget,
-                MEASURED_MIN_SIDE_RATIO,
-            );
-        }
+            },
+        )?;
     }
-    Ok(cube)
+    let densities = face_densities(&mut needs, cube.faces.len());
+    let by_need: ArrayVec<Option<[f64; 2]>, 6> = densities
+        .iter()
+        .map(|&d| (d > 0.0).then_some([d, d]))
+        .collect();
+    if by_need.iter().all(Option::is_none) {
+        return Ok(None);
+    }
+    cube.set_sizes_by_need_with_floor(&by_need, input.texel_budget, MEASURED_MIN_SIDE_RATIO);
+    let mut errors: ArrayVec<f64, MAX_SAMPLES> = needs
+        .iter()
+        .filter_map(|&(layer, need)| {
+            let side = cube.faces.get(layer)?.size.into_iter().min()?;
+            Some(need / f64::from(side.max(1)))
+        })
+        .collect();
+    Ok(percentile(&mut errors))
 }
 
 /// The smallest side of a face sized by measured needs ([`fit_cube`]), as a

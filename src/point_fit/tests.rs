@@ -9,7 +9,7 @@ use shadowmap_testgen::point_rtw::{
     CubeSamplesCase, PointRtwCase, check_cube_samples, check_point_rtw, check_tiled_samples,
     cube_samples_case, point_rtw_case,
 };
-use shadowmap_testgen::strategy;
+use shadowmap_testgen::{GenResult, strategy};
 
 /// Fits RTW over the paraboloid to a case and checks its coverage; the number of
 /// samples checked (0 when the fit refuses the case, e.g. a spot light).
@@ -43,10 +43,7 @@ fn fit_and_check(case: &PointRtwCase) -> usize {
 fn fit_cube_and_check(case: &CubeSamplesCase, warped: bool) -> Result<usize, String> {
     let c = &case.cube;
     let budget = 1 << 16;
-    let input = FitInput::new(&c.camera, &c.light, c.scene, budget)
-        .with_eye_samples(&case.samples)
-        .with_depth_bounds(c.bounds)
-        .with_pixels_per_radian(case.pixels_per_radian);
+    let input = cube_input(case, budget);
     let technique = if warped {
         Technique::CubeRtw {
             cube: c.options,
@@ -71,10 +68,7 @@ fn fit_cube_and_check(case: &CubeSamplesCase, warped: bool) -> Result<usize, Str
 fn fit_tiled_and_check(case: &CubeSamplesCase) -> Result<usize, String> {
     let c = &case.cube;
     let budget = 1 << 16;
-    let input = FitInput::new(&c.camera, &c.light, c.scene, budget)
-        .with_eye_samples(&case.samples)
-        .with_depth_bounds(c.bounds)
-        .with_pixels_per_radian(case.pixels_per_radian);
+    let input = cube_input(case, budget);
     let technique = Technique::TiledCube {
         cube: c.options,
         tiles: TileOptions::default(),
@@ -186,18 +180,26 @@ fn face_densities_are_the_least_texels_that_serve_the_percentile() {
     assert!(texels(&greedy) > 1.3 * texels(&exact), "{greedy:?}");
 }
 
-/// The fit inputs of up to `count` generated point-light cases with their eye
-/// samples and depth bounds (the scene a unit box: IPSM reads the camera and
-/// depth bounds, not the scene), from the xorshift `seed`.
-fn point_cases(seed: u64, count: usize) -> Vec<PointRtwCase> {
+/// The cases `generate` makes of up to `count` blocks of xorshift bytes from `seed`.
+fn generated<T>(
+    seed: u64,
+    count: usize,
+    generate: fn(&mut shadowmap_testgen::arbitrary::Unstructured<'_>) -> GenResult<T>,
+) -> Vec<T> {
     use shadowmap_testgen::arbitrary::Unstructured;
     let mut state = seed;
     (0..count)
         .filter_map(|_| {
             let bytes = shadowmap_testgen::xorshift_bytes(&mut state, 512);
-            point_rtw_case(&mut Unstructured::new(&bytes)).ok()
+            generate(&mut Unstructured::new(&bytes)).ok()
         })
         .collect()
+}
+
+/// Up to `count` generated point-light cases with their eye samples and depth
+/// bounds, from the xorshift `seed`.
+fn point_cases(seed: u64, count: usize) -> Vec<PointRtwCase> {
+    generated(seed, count, point_rtw_case)
 }
 
 /// The fit input of a generated point-light case.
@@ -299,18 +301,113 @@ fn ipsm_keeps_the_finest_map_on_the_front_lit_samples() {
     assert!(checked > 50, "{checked} cases");
 }
 
+/// RTW over the paraboloid keeps, of its warps over the plan's own map and over
+/// the map the IPSM techniques keep, the one of least error on the front-lit
+/// samples; each is kept in some cases.
+#[test]
+fn point_rtw_keeps_the_finer_of_its_two_bases() {
+    let (mut own, mut other) = (0, 0);
+    for case in point_cases(0x2f8a_61c4_93d0_b75e, 200) {
+        let budget = 1 << 16;
+        let input = point_input(&case).with_pixels_per_radian(500.0);
+        let rtw = RtwPlan::default().with_importance_side(32);
+        let options = case.plan.options;
+        let Ok(chosen) = fit_point_rtw(&options, &rtw, &input) else {
+            continue;
+        };
+        let error = |fitted: &Fitted| {
+            let Fitted::PointRtw { plan, front, back } = fitted else {
+                panic!("point_rtw fitted something else");
+            };
+            let mapping = WarpedParaboloid {
+                map: &plan.map,
+                front,
+                back: back.as_ref(),
+            };
+            let side = f64::from(layer_side(budget, plan.map.layers()));
+            let samples = Samples {
+                unlit: Unlit::Skipped,
+                ..Samples::new(&case.plan.camera, 500.0, &case.samples)
+            };
+            let light = LightDirection::Position(plan.map.position);
+            sample_error(&mapping, side, &samples, light, NEED_PERCENTILE).unwrap_or(f64::INFINITY)
+        };
+        let plan = IpsmPlan::new(
+            &case.plan.light,
+            &case.plan.camera,
+            case.plan.bounds,
+            &options,
+        )
+        .unwrap();
+        let kept = fit_ipsm(&options, &input).unwrap();
+        if kept.map == plan.map {
+            continue;
+        }
+        let over_own = warp_paraboloid(plan, &rtw, &input, &case.samples).unwrap();
+        let over_kept = warp_paraboloid(kept, &rtw, &input, &case.samples).unwrap();
+        let (e, a, b) = (error(&chosen), error(&over_own), error(&over_kept));
+        assert!(e <= a.min(b), "{e} kept, {a} and {b} on offer");
+        own += usize::from(e == a && a < b);
+        other += usize::from(e == b && b < a);
+    }
+    assert!(own >= 3 && other >= 3, "own {own}, other {other}");
+}
+
+/// Up to `count` generated cube-map cases with their eye samples, from the
+/// xorshift `seed`.
+fn cube_cases(seed: u64, count: usize) -> Vec<CubeSamplesCase> {
+    generated(seed, count, cube_samples_case)
+}
+
+/// The fit input of a generated cube-map case over `budget` texels.
+fn cube_input(case: &CubeSamplesCase, budget: u64) -> FitInput<'_> {
+    let c = &case.cube;
+    FitInput::new(&c.camera, &c.light, c.scene, budget)
+        .with_eye_samples(&case.samples)
+        .with_depth_bounds(c.bounds)
+        .with_pixels_per_radian(case.pixels_per_radian)
+}
+
+/// Cube maps sized by the samples' needs with the orientation left to the fit keep
+/// the orientation whose samples' error is the smaller; both are kept in some
+/// cases.
+#[test]
+fn cube_keeps_the_finer_orientation_on_the_samples() {
+    let (mut world, mut turned) = (0, 0);
+    for case in cube_cases(0x7c3e_9a51_d28f_4b61, 300) {
+        let input = cube_input(&case, 1 << 16);
+        let options = case.cube.options.with_sizes(FaceSizes::ByNeed);
+        let error = |cube: &CubeMap| {
+            let mut cube = cube.clone();
+            size_by_samples(&mut cube, &input, &case.samples, case.pixels_per_radian)
+                .unwrap()
+                .unwrap_or(f64::INFINITY)
+        };
+        let fitted = |o| fit_cube(&options.with_orientation(o), &input);
+        let (Ok(chosen), Ok(a), Ok(b)) = (
+            fitted(CubeOrientation::Predicted),
+            fitted(CubeOrientation::WorldAxes),
+            fitted(CubeOrientation::TowardReceivers),
+        ) else {
+            continue;
+        };
+        let (e, a, b) = (error(&chosen), error(&a), error(&b));
+        assert!(e <= a.min(b), "{e} kept, {a} and {b} on offer");
+        world += usize::from(e == a && a < b);
+        turned += usize::from(e == b && b < a);
+    }
+    assert!(
+        world >= 10 && turned >= 10,
+        "world {world}, turned {turned}"
+    );
+}
+
 /// The property below checks samples on most generated cases, with and without
 /// the warp, and tiled (not a generator whose fits all fail).
 #[test]
 fn cube_cases_reach_fitted_maps() {
-    use shadowmap_testgen::arbitrary::Unstructured;
-    let mut state = 0x2545_f491_4f6c_dd1d_u64;
     let (mut fitted, mut checked) = (0, 0);
-    for _ in 0..300 {
-        let bytes = shadowmap_testgen::xorshift_bytes(&mut state, 512);
-        let Ok(case) = cube_samples_case(&mut Unstructured::new(&bytes)) else {
-            continue;
-        };
+    for case in cube_cases(0x2545_f491_4f6c_dd1d, 300) {
         for warped in [false, true] {
             let n = fit_cube_and_check(&case, warped).unwrap();
             fitted += usize::from(n > 0);

@@ -12,7 +12,7 @@
 //! |---|---|
 //! | directional | uniform focused, stable and tight cascades (PSSM over the depth bounds), LiSPSM, XPSM, TSM, warped cascades (PSSM + LiSPSM), auto (the candidate with the lowest error on the eye samples), RTW (backward importance), RTW oracle |
 //! | spot | spot fit, LiSPSM and TSM in the spot's post-projective space, RTW over the spot fit |
-//! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone (both measured on the eye's samples against their dual alternatives), cube maps focused on the visible receivers with faces sized by the samples' needs, the engines' cube maps (equal full faces: a reference, not one of the library's techniques), RTW over the IPSM paraboloid, RTW over the focused cube faces |
+//! | point | DPSM, IPSM with the paper's cone, IPSM with the exact minimal cone (both measured on the eye's samples against their dual alternatives), cube maps focused on the visible receivers with faces sized by the samples' needs (world-axis or turned toward the receivers, whichever the samples measure finer), the engines' cube maps (equal full faces: a reference, not one of the library's techniques), RTW over the IPSM paraboloid (the plan's own or the one the IPSM rows keep, whichever warps finer on the samples), RTW over the focused cube faces |
 //!
 //! Budget: `texel_budget` texels in total ([`TechniqueOptions`], default `1024²`),
 //! split evenly over the layers: one `1024²` map, four cascades of `512²`, a dual
@@ -25,8 +25,8 @@
 
 use glam::{DMat4, DVec2, DVec3, DVec4, Vec3};
 use shadowmap::paraboloid::{
-    ConeFit, CubeMap, CubeOptions, FaceSizes, IpsmOptions, Side, SubdivisionOptions, TileOptions,
-    TiledCube, subdivide_triangles,
+    ConeFit, CubeMap, CubeOptions, CubeOrientation, FaceSizes, IpsmOptions, Side,
+    SubdivisionOptions, TileOptions, TiledCube, subdivide_triangles,
 };
 use shadowmap::rtw::{
     EyeSample, RtwSubdivision, WarpMaps, subdivide_for_rtw, subdivide_for_rtw_clipped,
@@ -103,11 +103,12 @@ pub enum TechniqueKind {
     IpsmExact,
     /// Cube maps: the faces that see visible receivers, each focused on them
     /// (`shadowmap_paraboloid::CubeMap`), sized by the density the eye's samples
-    /// need; the point lights' baseline.
+    /// need, the cube along the world axes or turned toward the receivers, whichever
+    /// the samples measure finer.
     Cube,
-    /// The engines' cube maps: the same faces at their full 90 degrees over the
-    /// light's range, equal sides (one texture-array layer each). A reference row,
-    /// not one of the library's techniques.
+    /// The engines' cube maps: the world-axis faces that see visible receivers at
+    /// their full 90 degrees over the light's range, equal sides (one texture-array
+    /// layer each). A reference row, not one of the library's techniques.
     CubeUnfocused,
     /// Rectilinear texture warping over the spot fit (a perspective base), importance
     /// from the eye's samples.
@@ -257,11 +258,16 @@ impl TechniqueKind {
             Self::Dpsm => T::Dpsm(Default::default()),
             Self::IpsmPaper => ipsm(ConeFit::Paper),
             Self::IpsmExact => ipsm(ConeFit::Exact),
-            Self::Cube => T::CubeMaps(CubeOptions::default().with_sizes(FaceSizes::ByNeed)),
+            Self::Cube => T::CubeMaps(
+                CubeOptions::default()
+                    .with_sizes(FaceSizes::ByNeed)
+                    .with_orientation(CubeOrientation::Predicted),
+            ),
             Self::CubeUnfocused => T::CubeMaps(
                 CubeOptions::default()
                     .with_focused(false)
-                    .with_sizes(FaceSizes::Equal),
+                    .with_sizes(FaceSizes::Equal)
+                    .with_orientation(CubeOrientation::WorldAxes),
             ),
             Self::CubeRtw => T::CubeRtw {
                 cube: CubeOptions::default(),

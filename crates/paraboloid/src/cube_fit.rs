@@ -21,7 +21,7 @@ use arrayvec::ArrayVec;
 use glam::{DVec2, DVec3};
 use shadowmap_frustum::{Aabb, ConvexBody, Frustum, MAX_BODY_VERTICES};
 
-use crate::cube::CubeFaceId;
+use crate::cube::FaceAxes;
 
 /// Most projected points of one face: the body's vertices and the crossings of
 /// vertex pairs (at most `(V / 2)²` pairs straddle the plane).
@@ -67,7 +67,9 @@ impl FaceExtent {
     /// The final window and depth range.
     ///
     /// `near` is the smallest near plane ([`effective_near`]).
-    /// Unfocused: the whole face over `[near, range]`. Focused: the window
+    /// Unfocused: the whole face over `[near, range]`, widened by [`WINDOW_MARGIN`]
+    /// where the cube is `turned` (its axes are rounded, and a point on the edge
+    /// between two faces could land just outside both). Focused: the window
     /// widened by [`WINDOW_MARGIN`] and to at least `min_extent` per axis (about its
     /// centre, kept inside the face), far at the receivers' largest depth (at most
     /// `range`), near at the smallest face depth of the casters (the casters ∩ range
@@ -83,14 +85,16 @@ impl FaceExtent {
     pub(crate) fn choose_depth(
         &mut self,
         focused: bool,
+        turned: bool,
         near: f64,
         range: f64,
-        casters: Option<(&Aabb, DVec3, CubeFaceId)>,
+        casters: Option<(&Aabb, DVec3, &FaceAxes)>,
         min_extent: f64,
     ) {
         if !focused {
-            self.tan_min = DVec2::NEG_ONE;
-            self.tan_max = DVec2::ONE;
+            let whole = if turned { 1.0 + WINDOW_MARGIN } else { 1.0 };
+            self.tan_min = DVec2::splat(-whole);
+            self.tan_max = DVec2::splat(whole);
             self.near = near;
             self.far = range.max(near * 1.001);
             return;
@@ -121,14 +125,13 @@ impl FaceExtent {
 fn casters_min_depth(
     casters: &Aabb,
     light: DVec3,
-    face: CubeFaceId,
+    face: &FaceAxes,
     window: (DVec2, DVec2),
     near: f64,
     far: f64,
 ) -> Option<f64> {
     let (lo, hi) = window;
-    let (f, u) = (face.forward().as_dvec3(), face.up().as_dvec3());
-    let r = f.cross(u);
+    let (f, u, r) = (face.forward, face.up, face.right);
     let corner = |d: f64, x: f64, y: f64| (light + (r * x + u * y + f) * d).as_vec3();
     let at = |d: f64| {
         [
@@ -161,7 +164,7 @@ fn casters_min_depth(
 /// The window of `face` on a convex body given by its vertices relative to the
 /// light, in front of the plane at face depth `near` (see the module docs); `None`
 /// when the body misses the face's pyramid there.
-pub(crate) fn face_extent(relative: &[DVec3], face: CubeFaceId, near: f64) -> Option<FaceExtent> {
+pub(crate) fn face_extent(relative: &[DVec3], face: &FaceAxes, near: f64) -> Option<FaceExtent> {
     let coords: ArrayVec<DVec3, MAX_BODY_VERTICES> = relative
         .iter()
         .take(MAX_BODY_VERTICES)
@@ -207,7 +210,7 @@ pub(crate) fn face_extent(relative: &[DVec3], face: CubeFaceId, near: f64) -> Op
 
 /// The smallest face depth of a box's corners relative to the light (exact for the
 /// box: depth is linear).
-pub(crate) fn min_depth_of_box(aabb: &Aabb, light: DVec3, face: CubeFaceId) -> f64 {
+pub(crate) fn min_depth_of_box(aabb: &Aabb, light: DVec3, face: &FaceAxes) -> f64 {
     aabb.corners()
         .iter()
         .map(|c| face.coords(c.as_dvec3() - light).z)
@@ -215,7 +218,15 @@ pub(crate) fn min_depth_of_box(aabb: &Aabb, light: DVec3, face: CubeFaceId) -> f
 }
 
 /// Andrew's monotone chain: the hull in counter-clockwise order (sorts `points`).
+///
+/// Zeros are made positive first: the total order puts `-0.0` before `0.0`, and
+/// points on the line `x = 0` split between the two would reach the chain out of
+/// order, which drops a hull vertex among them (a receiver straight along a face's
+/// axis from a light at the frustum's corner).
 fn convex_hull(points: &mut Points) -> Points {
+    for p in points.iter_mut() {
+        *p += DVec2::ZERO;
+    }
     points.sort_unstable_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     let mut hull = Points::new();
     let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
@@ -288,6 +299,29 @@ mod tests {
         assert!(!hull.contains(&DVec2::splat(0.5)));
     }
 
+    /// A light at a corner of the view's far face, the receivers the view's
+    /// frustum: the far face's other corner along `-X` lies on the `x = 0` edge of
+    /// the `-X` face's hull with crossings of the near plane, some of them at `-0.0`
+    /// and some at `0.0`. The window still reaches it.
+    #[test]
+    fn a_receiver_along_the_face_axis_stays_in_the_window() {
+        let relative = [
+            [-82.02732, -54.685318, 99.9],
+            [-81.86343, -54.685318, 99.9],
+            [-81.86343, -54.576057, 99.9],
+            [-82.02732, -54.576057, 99.9],
+            [-163.89075, -109.26094, 0.0],
+            [0.0, -109.26094, 0.0],
+            [0.0, -0.000_434_875_5, 0.0],
+            [-163.89075, -0.000_434_875_5, 0.0f32],
+        ]
+        .map(|a| glam::Vec3::from(a).as_dvec3());
+        let neg_x = FaceAxes::new(crate::CubeFaceId::NegX, glam::DQuat::IDENTITY);
+        let e = face_extent(&relative, &neg_x, 0.003_927_745).expect("in front");
+        let along_axis = neg_x.coords(relative[7]);
+        assert!(e.tan_max.y >= along_axis.y / along_axis.z, "{e:?}");
+    }
+
     #[test]
     fn clipping_keeps_only_the_part_inside_the_square() {
         let mut tri = Points::new();
@@ -313,7 +347,8 @@ mod tests {
         // at d = 1 projects to (2, 0) / 1, outside; the front end to (0.2, 0).
         let rel = [DVec3::new(2.0, 0.0, 1.0), DVec3::new(2.0, 0.0, -10.0)];
         // NegZ looks along -Z: d = -z.
-        let e = face_extent(&rel, CubeFaceId::NegZ, 1.0).expect("in front");
+        let neg_z = FaceAxes::new(crate::CubeFaceId::NegZ, glam::DQuat::IDENTITY);
+        let e = face_extent(&rel, &neg_z, 1.0).expect("in front");
         assert!((e.receivers_max - 10.0).abs() < 1e-12);
         assert!((e.receivers_min - 1.0).abs() < 1e-12);
         // right of NegZ is +X: a = x.

@@ -398,27 +398,36 @@ pub(crate) fn shelves(
 
 impl CubeMap {
     /// Gives each kept face its size ([`CubeOptions::sizes`]) and its place in the
-    /// atlas.
+    /// atlas, with the needs predicted from the camera and the receivers' box (for
+    /// [`FaceSizes::ByNeed`], and for every sizing when `predict` is set); returns
+    /// the predicted error of the sized map: the largest of the faces' 95th
+    /// percentiles of `m` ([`predicted_needs`] over the face's side), `None` without
+    /// a prediction.
     pub(crate) fn share_budget(
         &mut self,
         camera: &Camera,
         receivers: &Aabb,
         options: &CubeOptions,
-    ) {
+        predict: bool,
+    ) -> Option<f64> {
         let budget = options.texel_budget;
-        let sizes = match options.sizes {
-            FaceSizes::Equal => equal_sizes(self.faces.len(), budget),
-            FaceSizes::ByNeed => {
-                let at = self.position.as_dvec3();
+        let needs = (predict || options.sizes == FaceSizes::ByNeed)
+            .then(|| predicted_needs(&self.faces, self.position.as_dvec3(), camera, receivers));
+        let sizes = match (&needs, options.sizes) {
+            (Some(needs), FaceSizes::ByNeed) => {
                 let needs: ArrayVec<Option<[f64; 2]>, 6> =
-                    predicted_needs(&self.faces, at, camera, receivers)
-                        .into_iter()
-                        .map(|n| n.map(|n| [n, n]))
-                        .collect();
+                    needs.iter().map(|n| n.map(|n| [n, n])).collect();
                 sizes_by_need(&needs, budget, MIN_SIDE_RATIO)
             }
+            _ => equal_sizes(self.faces.len(), budget),
         };
         self.set_sizes(&sizes);
+        let needs = needs?;
+        self.faces
+            .iter()
+            .zip(&needs)
+            .map(|(f, n)| n.map(|n| n / f64::from(f.size[0].max(f.size[1]).max(1))))
+            .try_fold(0.0_f64, |worst, m| m.map(|m| worst.max(m)))
     }
 
     /// Shares `budget` texels between the faces in proportion to `needs` (in face

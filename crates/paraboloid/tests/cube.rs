@@ -24,7 +24,7 @@ proptest! {
 
 /// The generator exercises the checks: most valid inputs fit a map with visible
 /// receivers to check, some with the light inside the view and a caster's bounds,
-/// and both face counts below and at six occur.
+/// both face counts below and at six occur, and turned cubes too.
 #[test]
 fn the_generator_reaches_the_interesting_cases() {
     use shadowmap_frustum::Light;
@@ -32,7 +32,7 @@ fn the_generator_reaches_the_interesting_cases() {
     use shadowmap_testgen::arbitrary::Unstructured;
     use shadowmap_testgen::cube::visible_points;
 
-    let (mut fitted, mut inside_caster, mut all_six, mut fewer) = (0, 0, 0, 0);
+    let (mut fitted, mut inside_caster, mut all_six, mut fewer, mut turned) = (0, 0, 0, 0, 0);
     let mut state = 0x2545_f491_4f6c_dd1d_u64;
     for _ in 0..400 {
         let bytes = shadowmap_testgen::xorshift_bytes(&mut state, 256);
@@ -56,10 +56,11 @@ fn the_generator_reaches_the_interesting_cases() {
         inside_caster += usize::from(input.scene.casters.contains(position));
         all_six += usize::from(cube.layers() == 6);
         fewer += usize::from(cube.layers() < 6);
+        turned += usize::from(cube.orientation() != glam::Quat::IDENTITY);
     }
     assert!(fitted >= 200, "only {fitted} of 400 inputs fitted");
     assert!(
-        inside_caster >= 20 && all_six >= 10 && fewer >= 50,
-        "{inside_caster} {all_six} {fewer}"
+        inside_caster >= 20 && all_six >= 10 && fewer >= 50 && turned >= 40,
+        "{inside_caster} {all_six} {fewer} {turned}"
     );
 }

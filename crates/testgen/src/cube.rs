@@ -10,7 +10,9 @@
 use arbitrary::Unstructured;
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use shadowmap_frustum::{Aabb, Camera, ConvexBody, DepthBounds, Light, SceneBounds, ShadowMapping};
-use shadowmap_paraboloid::{CubeFace, CubeFaceId, CubeMap, CubeOptions, ParaboloidError};
+use shadowmap_paraboloid::{
+    CubeFace, CubeFaceId, CubeMap, CubeOptions, CubeOrientation, ParaboloidError,
+};
 
 use crate::paraboloid::plan_input;
 use crate::{GenResult, aabb_raw, any_f32, any_vec3, camera_raw, in_range, log_uniform};
@@ -84,7 +86,12 @@ pub fn cube_input(u: &mut Unstructured<'_>) -> GenResult<CubeInput> {
     let options = CubeOptions::default()
         .with_near(log_uniform(u, 1e-3, 0.5)?)
         .with_focused(u.arbitrary()?)
-        .with_reversed_z(u.arbitrary()?);
+        .with_reversed_z(u.arbitrary()?)
+        .with_orientation(match u.int_in_range(0u8..=2)? {
+            0 => CubeOrientation::WorldAxes,
+            1 => CubeOrientation::TowardReceivers,
+            _ => CubeOrientation::Predicted,
+        });
     // The range sometimes stops short of the view.
     let range = if u.arbitrary()? {
         reach
@@ -170,8 +177,9 @@ pub fn visible_points(input: &CubeInput) -> Vec<Vec3> {
 /// Where a light-relative point lands on a face by the documented formula, without
 /// the window test: `(uv, face depth)`, `None` behind the light's plane.
 fn face_uv(face: &CubeFace, q: DVec3) -> Option<(DVec2, f64)> {
-    let f = face.face.forward().as_dvec3();
-    let up = face.face.up().as_dvec3();
+    let turn = face.orientation.as_dquat();
+    let f = turn * face.face.forward().as_dvec3();
+    let up = turn * face.face.up().as_dvec3();
     let (a, b, d) = (q.dot(f.cross(up)), q.dot(up), q.dot(f));
     if !(d > 0.0) {
         return None;
@@ -183,7 +191,8 @@ fn face_uv(face: &CubeFace, q: DVec3) -> Option<(DVec2, f64)> {
 
 /// Runs [`CubeMap::fit`] and checks the contract. An error is typed (valid input
 /// fails only with the camera's or scene's error, e.g. no visible receiver). An
-/// `Ok` map has 1 to 6 faces in [`CubeFaceId::ALL`] order, finite non-singular
+/// `Ok` map has 1 to 6 faces in [`CubeFaceId::ALL`] order sharing one orientation
+/// (a turn about the world's `Y` axis), finite non-singular
 /// matrices, windows inside the face (up to rounding), `near < far`; every visible
 /// receiver point beyond the near plane lands in a kept face, inside its window, at
 /// a depth in `[0, 1]` when within range; casters in a window are not clipped by the
@@ -238,6 +247,12 @@ fn check_faces(cube: &CubeMap) -> Result<(), String> {
     if order.windows(2).any(|w| w[0] >= w[1]) {
         return Err(format!("faces out of order: {order:?}"));
     }
+    // One orientation for all faces, a turn about the world's Y axis.
+    let turn = cube.orientation();
+    let level = (turn * Vec3::Y - Vec3::Y).length() < 1e-5;
+    if !turn.is_normalized() || !level || cube.faces.iter().any(|f| f.orientation != turn) {
+        return Err(format!("bad orientation {turn:?}"));
+    }
     for f in &cube.faces {
         let m = f.clip_from_world;
         let det = m.as_dmat4().determinant();
@@ -265,7 +280,10 @@ fn check_receiver(
     range: f32,
 ) -> Result<(), String> {
     let q = p.as_dvec3() - position.as_dvec3();
-    if q.abs().max_element() <= 1.01 * near_floor(input, position, range) {
+    // Closer than the near plane along every face axis (the cube's, turned): not
+    // stored.
+    let along_faces = cube.orientation().as_dquat().inverse() * q;
+    if along_faces.abs().max_element() <= 1.01 * near_floor(input, position, range) {
         return Ok(());
     }
     // f32 rounding of the point and of the body's vertices, as a tangent.

@@ -139,7 +139,8 @@ pub fn check_cube_samples(
                 .max(position.abs().max_element()),
         );
         // f32 rounding of the sample and of the fitted windows.
-        if q.abs().max_element() <= 1.01 * floor + 1e-3 * scale
+        let along_faces = cube.orientation().as_dquat().inverse() * q;
+        if along_faces.abs().max_element() <= 1.01 * floor + 1e-3 * scale
             || q.length() >= 0.99 * f64::from(range)
         {
             continue;

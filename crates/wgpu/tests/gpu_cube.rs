@@ -8,7 +8,7 @@
 
 use glam::Vec3;
 use shadowmap::Fitted;
-use shadowmap::paraboloid::{CubeMap, CubeOptions, FaceSizes};
+use shadowmap::paraboloid::{CubeMap, CubeOptions, CubeOrientation, FaceSizes};
 use shadowmap::{FitInput, Technique, fit};
 use shadowmap_eval::bvh::Bvh;
 use shadowmap_eval::mask::GBuffer;
@@ -159,7 +159,8 @@ fn cube_faces_match_the_cpu_rasterizer() {
 
 /// A frame through `render_shadow` (the face lookup by projection): its shadow mask
 /// is not trivial and agrees with a DPSM's of the same light on nearly every pixel
-/// both cover (the two differ only along shadow edges, at their own resolutions).
+/// both cover (the two differ only along shadow edges, at their own resolutions),
+/// the cube along the world axes or turned toward the receivers.
 #[test]
 fn cube_frames_shadow_what_a_dpsm_shadows() {
     let Some(ctx) = shadowmap_wgpu::context::test_context("cube_frames_shadow_what_a_dpsm_shadows")
@@ -200,6 +201,10 @@ fn cube_frames_shadow_what_a_dpsm_shadows() {
     let mut renderer = HeadlessRenderer::new();
     let mut mask = |technique: &Technique| {
         let shadow = fit(technique, &input).unwrap();
+        if let Technique::CubeMaps(o) = technique {
+            let turned = shadow.cube().unwrap().orientation() != glam::Quat::IDENTITY;
+            assert_eq!(turned, o.orientation == CubeOrientation::TowardReceivers);
+        }
 
         renderer
             .render_shadow(&ctx, &tris, &camera, &shadow, &options)
@@ -213,6 +218,7 @@ fn cube_frames_shadow_what_a_dpsm_shadows() {
         Technique::CubeMaps(equal),
         Technique::CubeMaps(equal.with_reversed_z(true)),
         Technique::CubeMaps(equal.with_focused(false)),
+        Technique::CubeMaps(equal.with_orientation(CubeOrientation::TowardReceivers)),
     ] {
         let values = mask(&cube);
         let count = |v: MaskValue| values.iter().filter(|g| **g == v).count();
