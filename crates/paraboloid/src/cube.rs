@@ -185,8 +185,8 @@ pub enum CubeOrientation {
     /// error at the budget: the largest over the kept faces of the 95th percentile of
     /// `m` predicted from the camera and the receivers' box (as
     /// [`FaceSizes::ByNeed`] predicts it), over the face's side. Fits the faces
-    /// twice and predicts twice: about 30 times the cost of either orientation alone
-    /// with equal faces (460 us against 15 us, `cargo bench --bench paraboloid --
+    /// twice and predicts twice: about 34 times the cost of either orientation alone
+    /// with equal faces (322 us against 9.5 us, `cargo bench --bench paraboloid --
     /// cube_fit`), so not the default; `shadowmap::fit` measures both orientations
     /// on the eye's samples instead when it has them.
     Predicted,
