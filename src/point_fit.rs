@@ -55,33 +55,46 @@ pub(crate) fn fit_point_rtw(
     let samples = eye_samples(input, "point_rtw")?;
     let own = IpsmPlan::new(input.light, input.camera, input.depth_bounds, ipsm)?;
     let warped_own = warp_paraboloid(own, plan, input, samples)?;
-    let kept = fit_ipsm(ipsm, input)?;
+    let kept = finest_ipsm(own, ipsm, input);
     let Some(ppr) = input.pixels_per_radian.filter(|_| kept.map != own.map) else {
         return Ok(warped_own);
     };
     let warped_kept = warp_paraboloid(kept, plan, input, samples)?;
-    let error = |fitted: &Fitted| {
-        let Fitted::PointRtw { plan, front, back } = fitted else {
-            return f64::INFINITY;
-        };
-        let mapping = WarpedParaboloid {
-            map: &plan.map,
-            front,
-            back: back.as_ref(),
-        };
-        let side = f64::from(layer_side(input.texel_budget, plan.map.layers()));
-        let measured = Samples {
-            unlit: Unlit::Skipped,
-            ..Samples::new(input.camera, ppr, samples)
-        };
-        let light = LightDirection::Position(plan.map.position);
-        sample_error(&mapping, side, &measured, light, NEED_PERCENTILE).unwrap_or(f64::INFINITY)
+    let error = |fitted: &Fitted| match fitted {
+        Fitted::PointRtw { plan, front, back } => {
+            let mapping = WarpedParaboloid {
+                map: &plan.map,
+                front,
+                back: back.as_ref(),
+            };
+            front_lit_error(&mapping, &plan.map, input, samples, ppr)
+        }
+        _ => f64::INFINITY,
     };
     Ok(if error(&warped_kept) < error(&warped_own) {
         warped_kept
     } else {
         warped_own
     })
+}
+
+/// The [`NEED_PERCENTILE`] of `m` over the front-lit samples (those the quality
+/// report measures) of `mapping`, a paraboloid mapping over `map` whose layers each
+/// get the budget's side for its layer count; infinite where it covers none.
+pub(crate) fn front_lit_error(
+    mapping: &dyn ShadowMapping,
+    map: &ParaboloidMap,
+    input: &FitInput<'_>,
+    samples: &[EyeSample],
+    pixels_per_radian: f32,
+) -> f64 {
+    let side = f64::from(layer_side(input.texel_budget, map.layers()));
+    let measured = Samples {
+        unlit: Unlit::Skipped,
+        ..Samples::new(input.camera, pixels_per_radian, samples)
+    };
+    let light = LightDirection::Position(map.position);
+    sample_error(mapping, side, &measured, light, NEED_PERCENTILE).unwrap_or(f64::INFINITY)
 }
 
 /// RTW's tables over each side of `ipsm`'s map (see [`fit_point_rtw`]).
@@ -132,12 +145,13 @@ fn warp_paraboloid(
     })
 }
 
-/// Both sides of a paraboloid map, each warped by its tables: what
-/// [`fit_point_rtw`] measures a base's warp on.
-struct WarpedParaboloid<'a> {
-    map: &'a ParaboloidMap,
-    front: &'a WarpMaps,
-    back: Option<&'a WarpMaps>,
+/// Both sides of a paraboloid map, each warped by its tables: RTW over the
+/// paraboloid as a mapping (the fitted technique's lookup, and what
+/// [`fit_point_rtw`] measures a base's warp on).
+pub(crate) struct WarpedParaboloid<'a> {
+    pub(crate) map: &'a ParaboloidMap,
+    pub(crate) front: &'a WarpMaps,
+    pub(crate) back: Option<&'a WarpMaps>,
 }
 
 impl ShadowMapping for WarpedParaboloid<'_> {
@@ -175,23 +189,16 @@ impl ShadowMapping for WarpedSide<'_> {
 /// the visible surfaces do not.
 pub(crate) fn fit_ipsm(options: &IpsmOptions, input: &FitInput<'_>) -> Result<IpsmPlan, FitError> {
     let plan = IpsmPlan::new(input.light, input.camera, input.depth_bounds, options)?;
+    Ok(finest_ipsm(plan, options, input))
+}
+
+/// Of `plan` and its dual alternatives, the finest on the front-lit eye samples
+/// (see [`fit_ipsm`]); `plan` without samples or pixels per radian.
+fn finest_ipsm(plan: IpsmPlan, options: &IpsmOptions, input: &FitInput<'_>) -> IpsmPlan {
     let (Some(samples), Some(ppr)) = (input.eye_samples, input.pixels_per_radian) else {
-        return Ok(plan);
+        return plan;
     };
-    let error = |p: &IpsmPlan| {
-        let side = f64::from(layer_side(input.texel_budget, p.map.layers()));
-        sample_error(
-            &p.map,
-            side,
-            &Samples {
-                unlit: Unlit::Skipped,
-                ..Samples::new(input.camera, ppr, samples)
-            },
-            LightDirection::Position(p.map.position),
-            NEED_PERCENTILE,
-        )
-        .unwrap_or(f64::INFINITY)
-    };
+    let error = |p: &IpsmPlan| front_lit_error(&p.map, &p.map, input, samples, ppr);
     let mut best = (error(&plan), plan);
     for axis in [None, Some(-options.up_hint)] {
         if let Ok(alternative) = plan.with_dual(axis, options) {
@@ -201,7 +208,7 @@ pub(crate) fn fit_ipsm(options: &IpsmOptions, input: &FitInput<'_>) -> Result<Ip
             }
         }
     }
-    Ok(best.1)
+    best.1
 }
 
 /// Cube maps. With [`FaceSizes::ByNeed`] and the eye samples and pixels per radian,
@@ -234,14 +241,23 @@ pub(crate) fn fit_cube(options: &CubeOptions, input: &FitInput<'_>) -> Result<Cu
     };
     let mut best: Option<(f64, CubeMap)> = None;
     for o in orientations {
-        let mut cube = fit_faces(&options.with_orientation(*o), input)?;
+        // Fitted at equal sides, sized by the samples; by the box's prediction only
+        // where no sample gives a need.
+        let oriented = options.with_orientation(*o);
+        let mut cube = fit_faces(&oriented.with_sizes(FaceSizes::Equal), input)?;
         if best
             .as_ref()
             .is_some_and(|(_, b)| b.orientation() == cube.orientation())
         {
             continue;
         }
-        let error = size_by_samples(&mut cube, input, samples, ppr)?.unwrap_or(f64::INFINITY);
+        let error = match size_by_samples(&mut cube, input, samples, ppr)? {
+            Some(error) => error,
+            None => {
+                cube = fit_faces(&oriented, input)?;
+                f64::INFINITY
+            }
+        };
         if best.as_ref().is_none_or(|(e, _)| error < *e) {
             best = Some((error, cube));
         }

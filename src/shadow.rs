@@ -302,11 +302,12 @@ impl ShadowMapping for Shadow {
                 let s = cube.map_point(world)?;
                 warps.get(s.layer as usize)?.warp_sample(s)
             }
-            Fitted::PointRtw { plan, front, back } => {
-                let s = plan.map.map_point(world)?;
-                let warps = if s.layer == 0 { front } else { back.as_ref()? };
-                warps.warp_sample(s)
+            Fitted::PointRtw { plan, front, back } => crate::point_fit::WarpedParaboloid {
+                map: &plan.map,
+                front,
+                back: back.as_ref(),
             }
+            .map_point(world),
             Fitted::Uniform(t) => t.map_point(world),
             Fitted::Lispsm(LispsmShadow { transform, .. })
             | Fitted::Xpsm(XpsmShadow { transform, .. })
