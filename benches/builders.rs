@@ -7,7 +7,9 @@
 //! per frame (`ValidCamera`), and the focus body alone with each warp fitted from a
 //! body built once (`FocusBody`: what a frame pays per technique once the body is
 //! shared), and the 4-cascade fits refitted in place into a set kept across calls
-//! (`CascadeSet::refit_valid`). Besides criterion's figures it prints one table: each
+//! (`CascadeSet::refit_valid`), and the held stable fit (`CascadeSet::fit_with_state`,
+//! maps fitted to slice ∩ receivers with their sizes kept in a state across calls).
+//! Besides criterion's figures it prints one table: each
 //! builder's time per call (the fastest of many short batches, see
 //! `support/timing.rs`) and its ratio to Bevy's 4 cascades. `BUILDERS_ONLY` runs one
 //! builder for instruction counting (see `only`).
@@ -15,8 +17,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Quat, Vec3};
 use shadowmap::frustum::{
-    Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, DepthBounds, Light,
-    Projection, SceneBounds, SplitScheme, ValidCamera, fit_spot,
+    Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, DepthBounds,
+    Light, Projection, SceneBounds, SplitScheme, ValidCamera, fit_spot,
 };
 use shadowmap::paraboloid::{ConeFit, IpsmOptions, IpsmPlan};
 use shadowmap::rtw::{ImportanceMap, WarpMaps, WarpOptions};
@@ -123,10 +125,12 @@ struct Outputs {
     warps: WarpMaps,
     /// One light's cascades.
     set: CascadeSet,
+    /// The stable maps held across frames.
+    held: CascadeState,
 }
 
 /// The builders, by name.
-const NAMES: [&str; 23] = [
+const NAMES: [&str; 24] = [
     "bevy_cascades_4",
     "uniform_focused",
     "stable_cascades_4",
@@ -150,6 +154,7 @@ const NAMES: [&str; 23] = [
     "tsm_from_body",
     "stable_cascades_4_refit",
     "tight_cascades_4_refit",
+    "stable_cascades_4_held",
 ];
 
 /// Keeps a builder's result where it was returned (the output is not moved out of
@@ -263,6 +268,14 @@ fn run(f: &Frame, out: &mut Outputs, which: usize) {
             keep(&fitted);
             black_box(&out.set);
         }
+        23 => {
+            // The stable fit the umbrella and the report use: each map fitted to
+            // slice ∩ receivers, its size and orientation held across calls.
+            let options = f.stable.with_scene(Some(f.scene));
+            let fitted =
+                CascadeSet::fit_with_state(&f.valid, light, &f.splits, &options, &mut out.held);
+            keep(&fitted);
+        }
         _ => unreachable!("no builder {which}"),
     }
 }
@@ -290,6 +303,7 @@ fn builders(c: &mut Criterion) {
     let mut out = Outputs {
         warps: WarpMaps::new(1024, 1).unwrap(),
         set: CascadeSet::fit_valid(&f.valid, f.light, &f.splits, &f.stable).unwrap(),
+        held: CascadeState::new(),
     };
     if only(&f, &mut out) {
         return;

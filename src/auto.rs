@@ -69,10 +69,10 @@ pub(crate) fn fit_auto(
     let candidates = auto_candidates(plan);
     let mut fitted: [Option<Shadow>; AUTO_CANDIDATE_COUNT] = Default::default();
     let mut tight_fitted = false;
-    // The warps back off on the samples as they do alone (half their warp ratio,
-    // or none): fitted at their predicted strength only, a warp the samples would
-    // back off half way is not among the candidates, and `auto` measured 1.2 times
-    // TSM (which did) over a fence at seed 14.
+    // The warps and warped cascades back off on the samples as they do alone
+    // (half their warp ratio, or none): fitted at their predicted strength only, a
+    // warp the samples would back off half way is not among the candidates, and
+    // `auto` measured 1.2 times TSM (which did) over a fence at seed 14.
     for (slot, technique) in fitted.iter_mut().zip(&candidates) {
         // The stable cascades' count is predicted by the same tight fits as the
         // tight cascades': fitted after them, they keep the count just chosen.

@@ -5,16 +5,15 @@ use arrayvec::ArrayVec;
 use glam::{DVec2, DVec3, Vec3};
 use shadowmap_frustum::{
     Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, HeldDepthRange,
-    Light, LightDirection, MAX_CASCADES, MAX_PREDICT_CANDIDATES, ShadowMapping, ShadowSample,
-    SplitScheme, ValidCamera,
+    MAX_CASCADES, MAX_PREDICT_CANDIDATES, ShadowMapping, ShadowSample, SplitScheme, ValidCamera,
 };
 use shadowmap_warp::{LispsmOptions, WarpedCascades, light_frame, warped_cascades};
 
-use crate::auto::AUTO_MAX_SAMPLES;
 use crate::fit::{FitError, FitInput, predictions};
-use crate::sample_error::{Samples, Unlit, confidently_at_most, percentile_of, sample_errors};
+use crate::sample_error::{confidently_at_most, percentile_of, sample_error, sample_errors};
 use crate::shadow::Fitted;
 use crate::technique::CascadePlan;
+use crate::warp_fit::{directional_samples, finest_strength};
 
 /// How a cascaded fit gets its count.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -54,26 +53,37 @@ pub(crate) fn fit_cascades(
     let held = *state;
     let candidate = |splits: &CascadeSplits, k: u32| -> Option<Candidate> {
         let options = cascade_options(input, k, direction).ok()?;
+        let mut scratch = held;
         let set = if stable {
             let options = options.with_fit(CascadeFit::Stable);
-            let mut scratch = held;
             CascadeSet::fit_with_state(&camera, direction, splits, &options, &mut scratch).ok()?
         } else {
             CascadeSet::fit_valid(&camera, direction, splits, &options).ok()?
         };
-        Some(Candidate::Cascades(set))
+        Some(Candidate::Cascades(set, scratch))
     };
-    let splits = choose_splits(plan, input, range, &mut count, &candidate, choice)?;
-    state.set_count(count);
+    let (splits, chosen) = choose_splits(plan, input, range, &mut count, &candidate, choice)?;
     let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
-    let fit = cascade_options(input, layers, direction)?
-        .with_reversed_z(plan.reversed_z)
-        .with_fit(if stable {
-            CascadeFit::Stable
-        } else {
-            CascadeFit::Tight
-        });
-    let set = CascadeSet::fit_with_state(&camera, direction, &splits, &fit, state)?;
+    let set = match chosen {
+        // The chosen count's candidate is the set as it is kept, and the state it
+        // left is the state to keep, unless the plan reverses the depth (the
+        // candidates are fitted without).
+        Some(Candidate::Cascades(set, after)) if !plan.reversed_z => {
+            *state = after;
+            set
+        }
+        _ => {
+            let fit = cascade_options(input, layers, direction)?
+                .with_reversed_z(plan.reversed_z)
+                .with_fit(if stable {
+                    CascadeFit::Stable
+                } else {
+                    CascadeFit::Tight
+                });
+            CascadeSet::fit_with_state(&camera, direction, &splits, &fit, state)?
+        }
+    };
+    state.set_count(count);
     Ok((Fitted::Cascades(set), layers))
 }
 
@@ -90,22 +100,24 @@ pub(crate) fn fit_warped(
 ) -> Result<(Fitted, u32), FitError> {
     let camera = ValidCamera::new(input.camera)?;
     let etas = [options.eta; MAX_CASCADES];
-    let fit = |splits: &CascadeSplits| {
+    let fit_at = |splits: &CascadeSplits, scale: f32| {
         warped_cascades(
             input.camera,
             direction,
             &input.scene,
             splits,
             etas.get(..splits.count()).unwrap_or(&[]),
-            options,
+            &options.with_strength_scale(options.strength_scale * scale),
         )
+        .map_err(FitError::from)
     };
+    let fit = |splits: &CascadeSplits| fit_at(splits, 1.0);
     let (eye, forward) = (input.camera.eye(), input.camera.forward());
     let warped = |splits: &CascadeSplits, _: u32| -> Option<Candidate> {
         Some(Candidate::Warped(fit(splits).ok()?, eye, forward))
     };
     let mut count = state.count();
-    let splits = choose_splits(
+    let (splits, chosen) = choose_splits(
         plan,
         input,
         {
@@ -117,7 +129,20 @@ pub(crate) fn fit_warped(
         CountChoice::Predict,
     )?;
     state.set_count(count);
-    let cascades = fit(&splits)?;
+    // Backed off on the eye's samples as the single warps are: where the slices'
+    // predicted warps measure worse there, half the warp ratio or none.
+    let samples = directional_samples(input);
+    let side = f64::from(input.layer_side(u32::try_from(splits.count()).unwrap_or(u32::MAX)));
+    let error = samples.as_ref().map(|(samples, light)| {
+        move |c: &WarpedCascades| sample_error(&c.view(eye, forward), side, samples, *light, 0.95)
+    });
+    // The count's candidate is the fit at the predicted strength (the same splits
+    // and options): fitted once.
+    let predicted = match chosen {
+        Some(Candidate::Warped(cascades, ..)) => cascades,
+        _ => fit(&splits)?,
+    };
+    let cascades = finest_strength(predicted, |scale| fit_at(&splits, scale), error)?;
     let fitted = Fitted::WarpedCascades {
         cascades,
         eye,
@@ -213,7 +238,9 @@ const COUNT_TAIL_GROWTH: f64 = 1.25;
     reason = "inline cascades keep the count choice allocation-free"
 )]
 enum Candidate {
-    Cascades(CascadeSet),
+    /// A stable or tight set and the state its fit left (the held maps of the
+    /// stable ones; the state it started from for the tight ones).
+    Cascades(CascadeSet, CascadeState),
     /// The cascades, the camera's eye and viewing direction.
     Warped(WarpedCascades, Vec3, Vec3),
 }
@@ -221,14 +248,14 @@ enum Candidate {
 impl ShadowMapping for Candidate {
     fn map_point(&self, world: DVec3) -> Option<ShadowSample> {
         match self {
-            Self::Cascades(set) => set.map_point(world),
+            Self::Cascades(set, _) => set.map_point(world),
             Self::Warped(cascades, eye, forward) => cascades.view(*eye, *forward).map_point(world),
         }
     }
 
     fn uv_differentials(&self, centre: DVec3, around: &[DVec3; 4]) -> Option<[DVec2; 2]> {
         match self {
-            Self::Cascades(set) => set.uv_differentials(centre, around),
+            Self::Cascades(set, _) => set.uv_differentials(centre, around),
             Self::Warped(cascades, eye, forward) => cascades
                 .view(*eye, *forward)
                 .uv_differentials(centre, around),
@@ -291,7 +318,7 @@ fn choose_splits(
     kept: &mut usize,
     fit: &dyn Fn(&CascadeSplits, u32) -> Option<Candidate>,
     choice: CountChoice,
-) -> Result<CascadeSplits, FitError> {
+) -> Result<(CascadeSplits, Option<Candidate>), FitError> {
     let max = plan.max_cascades.clamp(1, MAX_CASCADES);
     let side = |k: usize| input.layer_side(u32::try_from(k).unwrap_or(u32::MAX));
     let any_power = (1..=max).any(|k| side(k).is_power_of_two());
@@ -309,7 +336,7 @@ fn choose_splits(
         })
     };
     if choice == CountChoice::Keep && allowed(*kept) {
-        return splits_of(*kept);
+        return Ok((splits_of(*kept)?, None));
     }
     let mut candidates: ArrayVec<(usize, Candidate), MAX_CASCADES> = ArrayVec::new();
     for k in (1..=max).filter(|k| allowed(*k)) {
@@ -332,7 +359,12 @@ fn choose_splits(
     if !keep {
         *kept = best.unwrap_or(1);
     }
-    splits_of(*kept)
+    // The chosen count's fit on these very splits, for a caller that fits as the
+    // candidate was fitted.
+    let chosen = candidates
+        .into_iter()
+        .find_map(|(k, candidate)| (k == *kept).then_some(candidate));
+    Ok((splits_of(*kept)?, chosen))
 }
 
 /// The predicted 95th-percentile error of each candidate count (index `k`;
@@ -379,17 +411,7 @@ fn measured_errors(
     input: &FitInput<'_>,
     candidates: &[(usize, Candidate)],
 ) -> Option<[f64; MAX_CASCADES + 1]> {
-    let (Some(samples), Some(ppr), Light::Directional { direction }) =
-        (input.eye_samples, input.pixels_per_radian, *input.light)
-    else {
-        return None;
-    };
-    let samples = Samples {
-        most: AUTO_MAX_SAMPLES,
-        unlit: Unlit::Skipped,
-        ..Samples::new(input.camera, ppr, samples)
-    };
-    let light = LightDirection::Directional(direction);
+    let (samples, light) = directional_samples(input)?;
     let mut scores = [f64::INFINITY; MAX_CASCADES + 1];
     let mut errors = ArrayVec::new();
     // One map's percentile, measured first (the candidates come by count).

@@ -46,7 +46,12 @@ pub enum Technique {
     Tsm(TsmOptions),
     /// Parallel splits with a LiSPSM warp per cascade, over the depth bounds; the
     /// count is chosen from their own predicted error (one warped map over a short
-    /// range can beat four). Directional light.
+    /// range can beat four), or measured on the eye samples when the frame has
+    /// them. With samples the warps then back off as the single warps do: the
+    /// cascades are also fitted at half their warp ratio and at none, and the
+    /// finest on the samples is kept (one warped map over a room at seed 44 of the
+    /// sweeps measured 1.19 times the uniform fit at full strength). Directional
+    /// light.
     WarpedCascades {
         /// Split count and placement.
         plan: CascadePlan,

@@ -65,34 +65,59 @@ pub(crate) fn fit_warp(
             _ => return Err(FitError::NoCandidate),
         })
     };
-    let predicted = fit_at(SCALES[0])?;
-    let (Some(samples), Some(ppr), Light::Directional { .. }) =
+    let samples = directional_samples(input);
+    let error = samples.as_ref().map(|(samples, light)| {
+        |fitted: &Fitted| {
+            let mapping: &dyn ShadowMapping = match fitted {
+                Fitted::Lispsm(s) => &s.transform,
+                Fitted::Xpsm(s) => &s.transform,
+                Fitted::Tsm(s) => &s.transform,
+                _ => return None,
+            };
+            sample_error(mapping, 1.0, samples, *light, 0.95)
+        }
+    });
+    finest_strength(fit_at(SCALES[0])?, fit_at, error)
+}
+
+/// The eye samples of `input` as the warps and `auto` measure on them (at most
+/// [`AUTO_MAX_SAMPLES`], unlit ones skipped) and the light, `None` without samples,
+/// the image's focal length or a directional light.
+pub(crate) fn directional_samples<'a>(
+    input: &FitInput<'a>,
+) -> Option<(Samples<'a>, LightDirection)> {
+    let (Some(samples), Some(ppr), Light::Directional { direction }) =
         (input.eye_samples, input.pixels_per_radian, *input.light)
     else {
-        return Ok(predicted);
+        return None;
     };
     let samples = Samples {
         most: AUTO_MAX_SAMPLES,
         unlit: Unlit::Skipped,
-        ..Samples::new(camera, ppr, samples)
+        ..Samples::new(input.camera, ppr, samples)
     };
-    let light = LightDirection::Directional(direction);
-    let measure = |fitted: &Fitted| {
-        let mapping: &dyn ShadowMapping = match fitted {
-            Fitted::Lispsm(s) => &s.transform,
-            Fitted::Xpsm(s) => &s.transform,
-            Fitted::Tsm(s) => &s.transform,
-            _ => return None,
-        };
-        sample_error(mapping, 1.0, &samples, light, 0.95)
+    Some((samples, LightDirection::Directional(direction)))
+}
+
+/// The finest of a warp fitted at each share of its predicted strength in
+/// [`SCALES`] (`predicted`, the fit at the first share, then `fit_at(scale)` at the
+/// others), by `error` (the 95th percentile over the eye's samples); `predicted`
+/// alone without `error` or where it measures nothing. Ties keep the stronger warp.
+pub(crate) fn finest_strength<T>(
+    predicted: T,
+    fit_at: impl Fn(f32) -> Result<T, FitError>,
+    error: Option<impl Fn(&T) -> Option<f64>>,
+) -> Result<T, FitError> {
+    let Some(error) = error else {
+        return Ok(predicted);
     };
-    let Some(mut least) = measure(&predicted) else {
+    let Some(mut least) = error(&predicted) else {
         return Ok(predicted);
     };
     let mut best = predicted;
     for scale in SCALES.into_iter().skip(1) {
         let Ok(fitted) = fit_at(scale) else { continue };
-        if let Some(e) = measure(&fitted).filter(|e| *e < least) {
+        if let Some(e) = error(&fitted).filter(|e| *e < least) {
             (least, best) = (e, fitted);
         }
     }
@@ -107,6 +132,7 @@ mod tests {
 
     use super::*;
     use crate::fit::{depth_bounds_of, fit};
+    use crate::technique::CascadePlan;
     use crate::test_views::{room_samples, unit_random};
 
     /// With the eye's samples, LiSPSM, XPSM and TSM are never measured worse on them
@@ -118,7 +144,7 @@ mod tests {
         let mut state = 0x9e37_79b9_7f4a_7c15_u64;
         let mut next = || unit_random(&mut state);
         let room = Aabb::new(Vec3::new(-3.0, 0.0, -4.0), Vec3::new(3.0, 2.8, 4.0));
-        let (mut checked, mut backed_off) = (0, 0);
+        let (mut checked, mut backed_off, mut warped_backed_off) = (0, 0, 0);
         for _ in 0..60 {
             let eye = Vec3::new(4.0 * next() - 2.0, 1.2 + next(), 6.0 * next() - 3.0);
             let heading = core::f32::consts::TAU * next();
@@ -147,8 +173,14 @@ mod tests {
                     ..Samples::new(&camera, 48.0, &samples)
                 };
                 let light = LightDirection::Directional(direction);
-                sample_error(shadow.transform()?, 1.0, &samples, light, 0.95)
+                sample_error(shadow, 1.0, &samples, light, 0.95)
             };
+            // One warped cascade: the count cannot differ between the two.
+            let one = CascadePlan {
+                max_cascades: 1,
+                ..CascadePlan::default()
+            };
+            let warped = |lispsm: LispsmOptions| Technique::WarpedCascades { plan: one, lispsm };
             for (full, none) in [
                 (
                     Technique::Lispsm(LispsmOptions::default()),
@@ -161,6 +193,10 @@ mod tests {
                 (
                     Technique::Tsm(TsmOptions::default()),
                     Technique::Tsm(TsmOptions::default().with_strength_scale(0.0)),
+                ),
+                (
+                    warped(LispsmOptions::default()),
+                    warped(LispsmOptions::default().with_strength_scale(0.0)),
                 ),
             ] {
                 let (Ok(chosen), Ok(uniform), Ok(predicted)) =
@@ -176,11 +212,13 @@ mod tests {
                 assert!(c <= u * (1.0 + 1e-9), "{}: {c} vs {u}", full.name());
                 checked += 1;
                 backed_off += usize::from(p > u * 1.05);
+                warped_backed_off +=
+                    usize::from(matches!(full, Technique::WarpedCascades { .. }) && p > u * 1.05);
             }
         }
         assert!(
-            checked > 100 && backed_off > 0,
-            "{checked} checked, {backed_off}"
+            checked > 130 && backed_off > 0 && warped_backed_off > 0,
+            "{checked} checked, {backed_off} ({warped_backed_off} warped cascades)"
         );
     }
 }

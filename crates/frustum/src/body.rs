@@ -60,14 +60,18 @@ impl ConvexBody {
         Ok(out)
     }
 
-    /// The body from a frustum's exact `f64` corners (the builders' path: no `f32`
-    /// rounding of the corners before clipping).
-    pub(crate) fn from_dcorners_aabb(
+    /// The vertices of `frustum ∩ aabb` from a frustum's exact `f64` corners (the
+    /// builders' path: no `f32` rounding of the corners before clipping), as
+    /// [`ConvexBody::frustum_aabb_vertices`] finds them.
+    pub(crate) fn dcorners_aabb_vertices(
         corners: &[DVec3; 8],
         aabb: &Aabb,
-    ) -> Result<Self, FrustumError> {
+    ) -> Result<ArrayVec<Vec3, MAX_FRUSTUM_AABB_VERTICES>, FrustumError> {
         let planes = crate::frustum::dplanes(corners, 0.0)?;
-        Self::from_frustum_parts(&planes, corners, aabb)
+        let aabb = aabb.validate()?;
+        let mut out = ArrayVec::new();
+        frustum_clip(&planes, corners, &aabb).vertices(&mut out);
+        Ok(out)
     }
 
     /// `frustum ∩ aabb` from the frustum's planes and corners (see [`crate::clip`]).

@@ -3,6 +3,7 @@
 //! then each slice's light-space box (tight, stable sphere, stable ladder, or held
 //! across frames), its depth range pulled back to the casters, and its matrices.
 
+use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
 
 use crate::body::ConvexBody;
@@ -14,7 +15,9 @@ use crate::light::unit;
 use crate::light_prism::LightPrism;
 use crate::mapping::{LightDirection, ShadowTransform};
 use crate::rays::Rays;
-use crate::{Aabb, Camera, FrustumError, MAX_RESOLUTION, SceneBounds, math};
+use crate::{
+    Aabb, Camera, FrustumError, MAX_FRUSTUM_AABB_VERTICES, MAX_RESOLUTION, SceneBounds, math,
+};
 
 /// Fits a single cascade covering view depths `[near_depth, far_depth]`.
 ///
@@ -265,7 +268,7 @@ impl<'a> Fitter<'a> {
         let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
         // Largest world coordinate of the fitted points, for the invertibility test.
         let mut reach = 0.0f64;
-        for v in body.vertices() {
+        for v in &body {
             let p = v.as_dvec3();
             reach = reach.max(p.abs().max_element());
             let q = light.transform_point3(p);
@@ -306,13 +309,15 @@ impl<'a> Fitter<'a> {
         n: f64,
         f: f64,
         scene: &SceneBounds,
-    ) -> Result<ConvexBody, FrustumError> {
+    ) -> Result<ArrayVec<Vec3, MAX_FRUSTUM_AABB_VERTICES>, FrustumError> {
         let corners = self.camera.world_corners(n, f);
         let body =
-            ConvexBody::from_dcorners_aabb(&corners, &scene.receivers).map_err(|e| match e {
-                FrustumError::DegenerateFrustum => FrustumError::SliceOutsideScene,
-                e => e,
-            })?;
+            ConvexBody::dcorners_aabb_vertices(&corners, &scene.receivers).map_err(
+                |e| match e {
+                    FrustumError::DegenerateFrustum => FrustumError::SliceOutsideScene,
+                    e => e,
+                },
+            )?;
         if body.is_empty() {
             return Err(FrustumError::SliceOutsideScene);
         }
@@ -329,7 +334,7 @@ impl<'a> Fitter<'a> {
         held: &mut HeldSlot<'_>,
     ) -> Result<Cascade, FrustumError> {
         let body = self.receivers_body(n, f, scene)?;
-        let points = body.vertices().iter().map(|v| v.as_dvec3());
+        let points = body.iter().map(|v| v.as_dvec3());
         let b = held_box(
             &points,
             &scene.receivers,

@@ -267,23 +267,36 @@ fn short_mantissa_above(x: f64) -> f64 {
 }
 
 /// The held extents for a footprint whose extents (snap slack included) are
-/// `needed`, and `turned` when turned by up to the allowance (see [`STABLE_TURN`]):
+/// `needed`, and `turned()` when turned by up to the allowance (see [`STABLE_TURN`]):
 /// the previous `held` while it covers `needed` and is at most
 /// [`STABLE_SHRINK_RATIO`] times the size it would be chosen at, otherwise that
 /// size, `max(needed * STABLE_HEADROOM, turned)` rounded up to a short mantissa;
-/// and whether `held` was kept.
-fn hold_side(held: DVec2, needed: DVec2, turned: DVec2) -> (DVec2, bool) {
-    let target = turned.max(needed * STABLE_HEADROOM);
-    if held.cmpge(needed).all() && held.cmple(target * STABLE_SHRINK_RATIO).all() {
-        (held, true)
+/// and whether `held` was kept. The turned footprint is computed only where the
+/// footprint with the headroom does not settle the choice (most frames keep the
+/// held size without it).
+fn hold_side(
+    held: DVec2,
+    needed: DVec2,
+    turned: impl FnOnce() -> Result<DVec2, FrustumError>,
+) -> Result<(DVec2, bool), FrustumError> {
+    let least = needed * STABLE_HEADROOM;
+    let covers = held.cmpge(needed).all();
+    // The size it would be chosen at is at least `least`: a held size within the
+    // band over `least` is kept whatever the turned footprint.
+    if covers && held.cmple(least * STABLE_SHRINK_RATIO).all() {
+        return Ok((held, true));
+    }
+    let target = turned()?.max(least);
+    if covers && held.cmple(target * STABLE_SHRINK_RATIO).all() {
+        Ok((held, true))
     } else {
-        (
+        Ok((
             DVec2::new(
                 short_mantissa_above(target.x),
                 short_mantissa_above(target.y),
             ),
             false,
-        )
+        ))
     }
 }
 
@@ -371,9 +384,11 @@ pub(crate) fn held_box(
         }
         let scale = lo.abs().max(hi.abs()).max_element();
         let needed = with_slack(hi - lo, scale, res)?;
-        let turned = turned_extent(points, &light, phi).min(box_extent(receivers, &light));
-        let turned = with_slack(turned, scale, res)?;
-        let (side, kept) = hold_side(held, needed, turned);
+        let turned = || {
+            let turned = turned_extent(points, &light, phi).min(box_extent(receivers, &light));
+            with_slack(turned, scale, res)
+        };
+        let (side, kept) = hold_side(held, needed, turned)?;
         let texel = side / res;
         let center = ((lo + hi) * 0.5 / texel).round() * texel;
         let b = HeldBox {
@@ -409,34 +424,61 @@ pub(crate) fn held_box(
 mod tests {
     use super::*;
 
+    /// `hold_side` with a known turned footprint.
+    fn hold(held: DVec2, needed: DVec2, turned: DVec2) -> (DVec2, bool) {
+        hold_side(held, needed, || Ok(turned)).unwrap()
+    }
+
     #[test]
     fn size_is_kept_inside_the_band_and_renewed_outside() {
         let n = DVec2::new(10.0, 4.0);
         let turned = DVec2::new(10.2, 4.9);
-        let (first, kept) = hold_side(DVec2::ZERO, n, turned);
+        let (first, kept) = hold(DVec2::ZERO, n, turned);
         assert!(!kept);
         // The turned footprint, or the footprint with the headroom where that is
         // larger (x here), rounded up by less than 2%.
         let target = DVec2::new(n.x * STABLE_HEADROOM, turned.y);
         assert!(first.cmpge(target).all() && first.cmple(target * 1.016).all());
         // Grows within the margin: still covered, kept.
-        assert_eq!(hold_side(first, n * 1.02, turned * 1.02), (first, true));
-        assert_eq!(
-            hold_side(first, DVec2::new(10.0, 4.8), turned),
-            (first, true)
-        );
+        assert_eq!(hold(first, n * 1.02, turned * 1.02), (first, true));
+        assert_eq!(hold(first, DVec2::new(10.0, 4.8), turned), (first, true));
         // Grows past it: renewed from the new footprint.
-        let (renewed, kept) = hold_side(first, n * 1.3, turned * 1.3);
+        let (renewed, kept) = hold(first, n * 1.3, turned * 1.3);
         assert!(!kept && renewed.cmpge(turned * 1.3).all());
         assert!(renewed.cmpge(n * 1.3 * STABLE_HEADROOM).all());
         // Shrinks to 80%: kept; to 60%: the held map is more than 1.5 times the size
         // it would be chosen at, renewed.
-        assert!(hold_side(first, n * 0.8, turned * 0.8).1);
-        let (smaller, kept) = hold_side(first, n * 0.6, turned * 0.6);
+        assert!(hold(first, n * 0.8, turned * 0.8).1);
+        let (smaller, kept) = hold(first, n * 0.6, turned * 0.6);
         assert!(!kept && smaller.cmplt(first).all());
         // One axis too small renews both.
-        let (both, kept) = hold_side(first, DVec2::new(9.0, 8.0), DVec2::new(10.0, 8.0));
+        let (both, kept) = hold(first, DVec2::new(9.0, 8.0), DVec2::new(10.0, 8.0));
         assert!(!kept && both.y >= 8.0 * STABLE_HEADROOM && both.x < first.x);
+    }
+
+    #[test]
+    fn the_turned_footprint_is_computed_only_where_it_decides() {
+        let n = DVec2::new(10.0, 4.0);
+        let turned = DVec2::new(10.2, 4.9);
+        let (first, _) = hold(DVec2::ZERO, n, turned);
+        // Covered and within the band over the headroom alone: not asked for, and
+        // the same choice as with it.
+        let unasked = || -> Result<DVec2, FrustumError> { panic!("turned footprint asked for") };
+        assert_eq!(hold_side(first, n, unasked).unwrap(), (first, true));
+        assert_eq!(hold(first, n, turned), (first, true));
+        // Where the turn needs much more than the headroom, a footprint shrunk to
+        // 70% keeps the held size only by its turned extent (held y about 6.06,
+        // over 0.7 * 4 * 1.03 more than 1.5 times, over 0.7 * 6 less).
+        let wide_turn = DVec2::new(10.2, 6.0);
+        let (first, _) = hold(DVec2::ZERO, n, wide_turn);
+        assert_eq!(hold(first, n * 0.7, wide_turn * 0.7), (first, true));
+        assert!(!hold(first, n * 0.7, n * 0.7).1);
+        // Its error reaches the caller where it is needed.
+        let failing = || Err(FrustumError::EmptyBounds);
+        assert_eq!(
+            hold_side(DVec2::ZERO, n, failing),
+            Err(FrustumError::EmptyBounds)
+        );
     }
 
     #[test]
