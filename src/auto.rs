@@ -1,14 +1,15 @@
 //! `auto`: the candidate technique with the lowest predicted aliasing error.
 
 use arrayvec::ArrayVec;
-use shadowmap_frustum::{Light, LightDirection, ShadowMapping};
+use shadowmap_frustum::{LightDirection, ShadowMapping};
 use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 
 use crate::cascaded::CountChoice;
 use crate::fit::{FitError, FitInput, FitState, fit_candidate_with, predicted_percentiles};
-use crate::sample_error::{Samples, Unlit, sample_error};
+use crate::sample_error::{Samples, sample_error};
 use crate::shadow::Shadow;
 use crate::technique::{CascadePlan, Technique};
+use crate::warp_fit::directional_samples;
 
 /// Number of candidates of [`Technique::Auto`] ([`auto_candidates`]).
 pub const AUTO_CANDIDATE_COUNT: usize = 7;
@@ -85,14 +86,9 @@ pub(crate) fn fit_auto(
             tight_fitted = slot.is_some();
         }
     }
-    let percentiles = match (input.eye_samples, input.pixels_per_radian, *input.light) {
-        (Some(samples), Some(ppr), Light::Directional { direction }) if !samples.is_empty() => {
-            let samples = Samples {
-                most: AUTO_MAX_SAMPLES,
-                unlit: Unlit::Skipped,
-                ..Samples::new(input.camera, ppr, samples)
-            };
-            let measured = measure(&fitted, &samples, LightDirection::Directional(direction));
+    let percentiles = match directional_samples(input) {
+        Some((samples, light)) if !samples.samples.is_empty() => {
+            let measured = measure(&fitted, &samples, light);
             if measured.iter().any(Option::is_some) {
                 measured
             } else {
@@ -154,10 +150,11 @@ fn predict(
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
-    use shadowmap_frustum::{Aabb, Camera, Projection, SceneBounds};
+    use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds};
 
     use super::*;
     use crate::fit::{depth_bounds_of, fit};
+    use crate::sample_error::Unlit;
     use crate::test_views::street_samples;
 
     /// With the eye samples, `auto` keeps the candidate whose aliasing error on

@@ -203,6 +203,12 @@ fn point_cases(seed: u64, count: usize) -> Vec<PointRtwCase> {
 }
 
 /// The fit input of a generated point-light case.
+/// The IPSM plan of a case as its options make it, before any choice on samples.
+fn own_plan(case: &PointRtwCase) -> IpsmPlan {
+    let p = &case.plan;
+    IpsmPlan::new(&p.light, &p.camera, p.bounds, &p.options).unwrap()
+}
+
 fn point_input(case: &PointRtwCase) -> FitInput<'_> {
     FitInput::new(
         &case.plan.camera,
@@ -276,13 +282,7 @@ fn ipsm_keeps_the_finest_map_on_the_front_lit_samples() {
         if !kept.is_finite() {
             continue;
         }
-        let plan = IpsmPlan::new(
-            &case.plan.light,
-            &case.plan.camera,
-            case.plan.bounds,
-            &options,
-        )
-        .unwrap();
+        let plan = own_plan(&case);
         let alternatives =
             [None, Some(-options.up_hint)].map(|axis| plan.with_dual(axis, &options).ok());
         for other in alternatives.iter().flatten().chain([&plan]) {
@@ -318,13 +318,7 @@ fn point_rtw_keeps_the_finer_of_its_two_bases() {
             };
             front_lit_error(&mapping, &plan.map, &input, &case.samples, 500.0)
         };
-        let plan = IpsmPlan::new(
-            &case.plan.light,
-            &case.plan.camera,
-            case.plan.bounds,
-            &options,
-        )
-        .unwrap();
+        let plan = own_plan(&case);
         let kept = fit_ipsm(&options, &input).unwrap();
         if kept.map == plan.map {
             continue;
