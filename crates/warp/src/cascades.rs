@@ -64,7 +64,10 @@ pub fn warped_cascades(
             Some(v) => v,
             None => *valid.insert(ValidCamera::new(camera)?),
         };
+        // Read where it was built (see `FocusBody::fit_from`).
         let shadow = match FocusBody::slice_valid(&camera, near, far, light_direction, scene)
+            .as_ref()
+            .map_err(|e| *e)
             .and_then(|body| body.lispsm(&opts))
         {
             Ok(s) => {

@@ -254,7 +254,9 @@ impl Focus {
     }
 }
 
-pub(crate) fn focus(view: &View, light: Vec3, scene: &SceneBounds) -> Result<Focus, WarpError> {
+/// The focus body of `view` and `light`, written where it is returned (the body is a
+/// few kilobytes of fixed-capacity arrays: built field by field in place, not moved).
+fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, WarpError> {
     let dir = light_unit(light)?;
     let (receivers, casters) = check_scene(scene)?;
     // The vertices of the body alone: its planes are not needed here.
@@ -281,18 +283,21 @@ pub(crate) fn focus(view: &View, light: Vec3, scene: &SceneBounds) -> Result<Foc
         light_caster_scale = light_caster_scale.max(q.abs().max_element());
     }
     let receiver_scale = scale_of(&receivers);
-    Ok(Focus {
-        light: dir,
-        rot,
-        sin_gamma,
-        wide: footprint_weight(&footprint, receiver_scale),
-        caster_scale: scale_of(&casters),
-        light_caster_scale,
-        receiver_scale,
-        light_bounds,
-        receivers,
-        casters,
-        caster_box: scene.casters,
+    Ok(FocusBody {
+        view,
+        focus: Focus {
+            light: dir,
+            rot,
+            sin_gamma,
+            wide: footprint_weight(&footprint, receiver_scale),
+            caster_scale: scale_of(&casters),
+            light_caster_scale,
+            receiver_scale,
+            light_bounds,
+            receivers,
+            casters,
+            caster_box: scene.casters,
+        },
     })
 }
 
@@ -350,6 +355,23 @@ impl FocusBody {
         Self::new_valid(&ValidCamera::new(camera)?, light_direction, scene)
     }
 
+    /// `fit` applied to the focus body of a camera's whole frustum, read where it was
+    /// built: the body is a few kilobytes of fixed-capacity arrays, and moving it out
+    /// of its `Result` first would copy them (what the free functions
+    /// [`uniform_focused`](crate::uniform_focused), [`lispsm`](crate::lispsm), ...
+    /// call).
+    pub(crate) fn fit_from<T>(
+        camera: &Camera,
+        light_direction: Vec3,
+        scene: &SceneBounds,
+        fit: impl FnOnce(&Self) -> Result<T, WarpError>,
+    ) -> Result<T, WarpError> {
+        Self::new(camera, light_direction, scene)
+            .as_ref()
+            .map_err(|e| *e)
+            .and_then(fit)
+    }
+
     /// As [`FocusBody::new`] for a camera validated once per frame (see
     /// [`ValidCamera`]): the same body, without checking the camera again.
     ///
@@ -360,9 +382,11 @@ impl FocusBody {
         light_direction: Vec3,
         scene: &SceneBounds,
     ) -> Result<Self, WarpError> {
-        let view = View::with_frustum(camera.camera(), camera.frustum())?;
-        let focus = focus(&view, light_direction, scene)?;
-        Ok(Self { view, focus })
+        focus(
+            View::with_frustum(camera.camera(), camera.frustum())?,
+            light_direction,
+            scene,
+        )
     }
 
     /// The focus body of the slice of a camera's frustum between view depths
@@ -399,9 +423,11 @@ impl FocusBody {
         light_direction: Vec3,
         scene: &SceneBounds,
     ) -> Result<Self, WarpError> {
-        let view = View::with_frustum(camera.camera(), camera.slice(near, far)?)?;
-        let focus = focus(&view, light_direction, scene)?;
-        Ok(Self { view, focus })
+        focus(
+            View::with_frustum(camera.camera(), camera.slice(near, far)?)?,
+            light_direction,
+            scene,
+        )
     }
 
     /// The light frame (rotation only, see [`light_frame`](crate::light_frame)).

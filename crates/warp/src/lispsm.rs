@@ -160,7 +160,7 @@ pub fn lispsm(
     options: &LispsmOptions,
 ) -> Result<LispsmShadow, WarpError> {
     options.check()?;
-    FocusBody::new(camera, light_direction, scene)?.lispsm(options)
+    FocusBody::fit_from(camera, light_direction, scene, |body| body.lispsm(options))
 }
 
 impl FocusBody {

@@ -150,7 +150,7 @@ pub fn tsm(
     options: &TsmOptions,
 ) -> Result<TsmShadow, WarpError> {
     options.check()?;
-    FocusBody::new(camera, light_direction, scene)?.tsm(options)
+    FocusBody::fit_from(camera, light_direction, scene, |body| body.tsm(options))
 }
 
 impl FocusBody {

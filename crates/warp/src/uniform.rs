@@ -60,7 +60,7 @@ pub fn uniform_focused(
     scene: &SceneBounds,
     options: &UniformOptions,
 ) -> Result<ShadowTransform, WarpError> {
-    FocusBody::new(camera, light_direction, scene)?.uniform(options)
+    FocusBody::fit_from(camera, light_direction, scene, |body| body.uniform(options))
 }
 
 impl FocusBody {

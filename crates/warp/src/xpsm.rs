@@ -243,7 +243,7 @@ pub fn xpsm(
     options: &XpsmOptions,
 ) -> Result<XpsmShadow, WarpError> {
     options.validate()?;
-    FocusBody::new(camera, light_direction, scene)?.xpsm(options)
+    FocusBody::fit_from(camera, light_direction, scene, |body| body.xpsm(options))
 }
 
 impl FocusBody {
