@@ -6,7 +6,7 @@ use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 
 use crate::cascaded::CountChoice;
 use crate::fit::{FitError, FitInput, FitState, fit_candidate_with, predicted_percentiles};
-use crate::sample_error::{Samples, sample_error};
+use crate::sample_error::{PercentileBand, Samples, percentile_band, sample_error, sample_errors};
 use crate::shadow::Shadow;
 use crate::technique::{CascadePlan, Technique};
 use crate::warp_fit::directional_samples;
@@ -35,15 +35,14 @@ pub fn auto_candidates(plan: &CascadePlan) -> [Technique; AUTO_CANDIDATE_COUNT] 
     ]
 }
 
-/// Most eye samples `auto` measures each candidate on (a regular subset of the
-/// frame's): over the quality report's random sweep 512 choose as well as 1024 or
-/// 4096 (no view more than 1.08 times the best), in about 0.35 ms for the seven
-/// candidates (one derivative of each matrix per sample). With the tight cascades'
-/// count and the warps' strengths measured on the same samples, `auto` on a 160 x
-/// 90 G-buffer's samples takes about 1.4 ms a frame in all (`cargo bench --bench
-/// fit_state`: `auto_on_samples`, 455 times the uniform fit; 0.8 ms with the warps
-/// at their predicted strength only, which measured 1.2 times the best technique
-/// over a fence at seed 14).
+/// Most eye samples `auto` measures each candidate on first (a regular subset of
+/// the frame's): the candidates that could still be the best within that subset's
+/// noise are then measured again on more ([`AUTO_CONFIRM_SAMPLES`]). With the tight
+/// cascades' count and the warps' strengths measured on the same samples, `auto`
+/// on a 160 x 90 G-buffer's samples takes about 1.4 ms a frame in all (`cargo bench
+/// --bench fit_state`: `auto_on_samples`, 455 times the uniform fit; 0.8 ms with
+/// the warps at their predicted strength only, which measured 1.2 times the best
+/// technique over a fence at seed 14).
 pub const AUTO_MAX_SAMPLES: usize = 512;
 
 /// `auto`: fits every candidate, ranks them by their 95th-percentile aliasing error,
@@ -53,7 +52,8 @@ pub const AUTO_MAX_SAMPLES: usize = 512;
 /// The error is measured on the eye samples when the frame has them (and the
 /// image's focal length): the report's measure `m` on a regular subset of at most
 /// [`AUTO_MAX_SAMPLES`] front-lit samples, each candidate on the samples it
-/// covers, as the IPSM fit chooses its map. Without them (or without a front-lit
+/// covers, as the IPSM fit chooses its map, and the close ones again on more
+/// (see `measure`). Without them (or without a front-lit
 /// sample any candidate covers) it is predicted
 /// from the camera, the light and the bounds alone
 /// (`shadowmap_frustum::predict_errors`: the receivers' box stands in for the
@@ -110,18 +110,132 @@ pub(crate) fn fit_auto(
     Ok(shadow)
 }
 
+/// Most eye samples `auto` measures its contenders on a second time: the
+/// candidates whose 95th percentile on the first subset ([`AUTO_MAX_SAMPLES`]) could
+/// still be the lowest within that subset's noise (a percentile band of one binomial
+/// standard deviation of rank each way).
+pub const AUTO_CONFIRM_SAMPLES: usize = 4096;
+
 /// Each fitted candidate's 95th percentile on the eye `samples`, at its index in
-/// the candidate list (`None`: not fitted, or covering no sample).
+/// the candidate list (`None`: not fitted, covering no sample, or out of the
+/// running). Measured on a subset of at most [`AUTO_MAX_SAMPLES`] first; where more
+/// than one candidate could be the lowest within that subset's noise, those alone
+/// stay in the running, measured again on at most [`AUTO_CONFIRM_SAMPLES`]. A
+/// percentile near a knee of the errors (a few percent of the pixels on a wall seen
+/// edge-on, far coarser than the rest) lands on either side of it by chance on a
+/// small subset: TSM measured 2.10 on 478 samples of a view where it has 1.01 on
+/// 3,680 (and the next best 1.28). The second measure takes most samples, not a
+/// middle count: a regular subset can fall in step with the image's rows, and a
+/// 2,048-sample one measured three candidates of a view 1.4 times their 95th
+/// percentile on 4,096.
 fn measure(
     fitted: &[Option<Shadow>; AUTO_CANDIDATE_COUNT],
     samples: &Samples<'_>,
     light: LightDirection,
 ) -> [Option<f64>; AUTO_CANDIDATE_COUNT] {
-    fitted.each_ref().map(|shadow| {
+    let mut errors = ArrayVec::new();
+    let bands = fitted.each_ref().map(|shadow| {
         let shadow = shadow.as_ref()?;
-        let side = f64::from(shadow.layer_side);
-        sample_error(shadow, side, samples, light, 0.95)
-    })
+        sample_errors(
+            shadow,
+            f64::from(shadow.layer_side),
+            samples,
+            light,
+            &mut errors,
+        );
+        percentile_band(&mut errors, 0.95)
+    });
+    let measured = bands.map(|band| band.map(|b| b.value));
+    let contenders = contenders(&bands);
+    let again = contenders
+        .iter()
+        .filter(|c| **c == Contender::Again)
+        .count();
+    if samples.samples.len() <= samples.most || again < 2 {
+        return measured;
+    }
+    let more = Samples {
+        most: AUTO_CONFIRM_SAMPLES,
+        ..*samples
+    };
+    let mut confirmed = [None; AUTO_CANDIDATE_COUNT];
+    for (i, shadow) in fitted.iter().enumerate() {
+        if let (Contender::Again, Some(shadow)) = (contenders[i], shadow) {
+            let side = f64::from(shadow.layer_side);
+            confirmed[i] = sample_error(shadow, side, &more, light, 0.95).or(measured[i]);
+        }
+    }
+    for i in 0..AUTO_CANDIDATE_COUNT {
+        if let Contender::TwinOf(j) = contenders[i] {
+            confirmed[i] = confirmed[j];
+        }
+    }
+    confirmed
+}
+
+/// Most candidates `auto` measures a second time. Where the warps back off to the
+/// uniform fit and one map covers the view, every candidate can be within the
+/// first subset's noise of the others (in a room seen on 2,304 samples, bands from
+/// 1.1 to 3.4 wide); measuring them all again would cost up to seven times one
+/// measure on the larger subset.
+pub const AUTO_CONFIRM_CANDIDATES: usize = 3;
+
+/// What `measure` does with a candidate after the first subset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Contender {
+    /// Out of the running: it cannot be the lowest within the subset's noise, or
+    /// [`AUTO_CONFIRM_CANDIDATES`] more likely ones are measured again.
+    Out,
+    /// Measured again on more samples.
+    Again,
+    /// The same band as the candidate at this index, measured again: one
+    /// fit under two names (a warp backed off to the uniform fit), given its value.
+    TwinOf(usize),
+}
+
+/// The candidates whose percentile band reaches below the top of the lowest band
+/// (within the subset's noise, each of them could be the lowest): the one with the
+/// lowest percentile first, then those with the lowest bottoms, at most
+/// [`AUTO_CONFIRM_CANDIDATES`] of them measured again; a candidate with exactly the
+/// band of one measured again is its twin.
+fn contenders(
+    bands: &[Option<PercentileBand>; AUTO_CANDIDATE_COUNT],
+) -> [Contender; AUTO_CANDIDATE_COUNT] {
+    let lowest_high = bands
+        .iter()
+        .flatten()
+        .map(|b| b.high)
+        .fold(f64::INFINITY, f64::min);
+    let value = |i: usize| bands[i].map_or(f64::INFINITY, |b| b.value);
+    let low = |i: usize| bands[i].map_or(f64::INFINITY, |b| b.low);
+    let lowest = (0..AUTO_CANDIDATE_COUNT)
+        .min_by(|a, b| value(*a).total_cmp(&value(*b)).then(a.cmp(b)))
+        .unwrap_or(0);
+    let mut order: [usize; AUTO_CANDIDATE_COUNT] = core::array::from_fn(|i| i);
+    order.sort_by(|a, b| {
+        (*a != lowest)
+            .cmp(&(*b != lowest))
+            .then(low(*a).total_cmp(&low(*b)))
+            .then(a.cmp(b))
+    });
+    let mut contenders = [Contender::Out; AUTO_CANDIDATE_COUNT];
+    let mut again = 0;
+    for i in order {
+        if bands[i].is_none() || low(i) > lowest_high {
+            continue;
+        }
+        let twin = (0..AUTO_CANDIDATE_COUNT)
+            .find(|j| contenders[*j] == Contender::Again && bands[*j] == bands[i]);
+        contenders[i] = match twin {
+            Some(j) => Contender::TwinOf(j),
+            _ if again < AUTO_CONFIRM_CANDIDATES => {
+                again += 1;
+                Contender::Again
+            }
+            _ => Contender::Out,
+        };
+    }
+    contenders
 }
 
 /// Each fitted candidate's predicted 95th percentile, at its index in the candidate
@@ -156,6 +270,48 @@ mod tests {
     use crate::fit::{depth_bounds_of, fit};
     use crate::sample_error::Unlit;
     use crate::test_views::street_samples;
+
+    /// A candidate whose subset percentile lies past a knee of its errors (94% of
+    /// them fine, the rest twice as coarse) could be the lowest within the subset's
+    /// noise, and so could a candidate just above the knee's foot; one far above
+    /// both could not.
+    #[test]
+    fn a_percentile_past_a_knee_leaves_the_choice_to_more_samples() {
+        let band = |mut errors: Vec<f64>| percentile_band(&mut errors, 0.95);
+        let knee = band((0..478).map(|i| if i < 450 { 1.0 } else { 2.1 }).collect());
+        let knee_band = knee.unwrap();
+        assert_eq!((knee_band.low, knee_band.value), (1.0, 2.1));
+        let steady = band((0..478).map(|i| 1.2 + f64::from(i) * 1e-4).collect());
+        let coarse = band(vec![6.0; 478]);
+        let mut bands = [None; AUTO_CANDIDATE_COUNT];
+        bands[..3].copy_from_slice(&[knee, steady, coarse]);
+        use Contender::{Again, Out, TwinOf};
+        assert_eq!(contenders(&bands)[..3], [Again, Again, Out]);
+        // Without the knee the fine candidate alone is a contender.
+        bands[0] = band(vec![1.0; 478]);
+        assert_eq!(contenders(&bands)[..3], [Again, Out, Out]);
+        // Seven candidates within each other's noise: the lowest percentile, then
+        // the lowest bottoms; a candidate with the band of one measured again is
+        // its twin.
+        let spread = |k: usize| {
+            band(
+                (0..478)
+                    .map(|i| 2.0 - 1e-4 * k as f64 + f64::from(i) * 1e-4)
+                    .collect(),
+            )
+        };
+        let mut bands: [Option<PercentileBand>; AUTO_CANDIDATE_COUNT] =
+            core::array::from_fn(spread);
+        assert_eq!(
+            contenders(&bands),
+            [Out, Out, Out, Out, Again, Again, Again]
+        );
+        // A knee puts one candidate's bottom lowest, the lowest percentile stays.
+        bands[1] = knee;
+        bands[2] = knee;
+        let expected = [Out, Again, TwinOf(1), Out, Out, Again, Again];
+        assert_eq!(contenders(&bands), expected);
+    }
 
     /// With the eye samples, `auto` keeps the candidate whose aliasing error on
     /// them is the lowest, each candidate measured as the quality report measures

@@ -399,7 +399,7 @@ fn predicted_errors(
 
 /// The 95th percentile of the report's measure `m` of each candidate count (index
 /// `k`) on the frame's front-lit eye samples ([`sample_errors`], at most
-/// [`AUTO_MAX_SAMPLES`] of them, as `auto` ranks its candidates), raised to one
+/// [`AUTO_MAX_SAMPLES`] of them, as `auto` first ranks its candidates), raised to one
 /// map's where a count's samples do not show it at most one map's beyond their
 /// noise ([`confidently_at_most`]); `None` without
 /// samples, the image's focal length or a directional light, or where no candidate

@@ -163,7 +163,10 @@ mod test_views;
 mod warp_fit;
 
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
-pub use auto::{AUTO_CANDIDATE_COUNT, AUTO_MAX_SAMPLES, auto_candidates};
+pub use auto::{
+    AUTO_CANDIDATE_COUNT, AUTO_CONFIRM_CANDIDATES, AUTO_CONFIRM_SAMPLES, AUTO_MAX_SAMPLES,
+    auto_candidates,
+};
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 pub use fit::{
     FitError, FitInput, FitState, depth_bounds_of, fit, fit_with_selector, fit_with_state,

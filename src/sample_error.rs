@@ -113,6 +113,28 @@ pub(crate) fn confidently_at_most(errors: &[f64], threshold: f64, percentile: f6
     n > 0.0 && above <= n * tail - math::sqrt(n * tail * percentile)
 }
 
+/// A percentile measured on a subset, with the values at the ranks one binomial
+/// standard deviation below and above its own (`sqrt(n p (1 - p))` ranks): where
+/// the errors have a knee near the percentile, `low` and `high` lie far apart, and
+/// a subset's `value` may sit on either side of the knee by chance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PercentileBand {
+    pub(crate) low: f64,
+    pub(crate) value: f64,
+    pub(crate) high: f64,
+}
+
+/// The `percentile` of `values` (reordered) with its band ([`PercentileBand`]),
+/// `None` where [`percentile_of`] is.
+pub(crate) fn percentile_band(values: &mut [f64], percentile: f64) -> Option<PercentileBand> {
+    let n = values.len() as f64;
+    let spread = math::sqrt(percentile * (1.0 - percentile) / n.max(1.0));
+    let value = percentile_of(values, percentile)?;
+    let low = percentile_of(values, (percentile - spread).max(0.0)).unwrap_or(value);
+    let high = percentile_of(values, (percentile + spread).min(1.0)).unwrap_or(value);
+    Some(PercentileBand { low, value, high })
+}
+
 /// What [`sample_error`] measures a sample with.
 struct Probe {
     steps: PixelSteps,

@@ -62,7 +62,9 @@ pub enum Technique {
     /// LiSPSM, TSM, XPSM and the three cascaded techniques with this plan) with the
     /// lowest 95th-percentile aliasing error: measured on the eye samples when the
     /// frame has them and the image's focal length (the quality report's measure on
-    /// at most [`AUTO_MAX_SAMPLES`](crate::AUTO_MAX_SAMPLES) front-lit samples),
+    /// at most [`AUTO_MAX_SAMPLES`](crate::AUTO_MAX_SAMPLES) front-lit samples,
+    /// the candidates still close within that subset's noise again on at most
+    /// [`AUTO_CONFIRM_SAMPLES`](crate::AUTO_CONFIRM_SAMPLES)),
     /// otherwise predicted from the camera, light and bounds alone
     /// (`shadowmap_frustum::predict_errors`: the receivers' box within the depth
     /// bounds, no rendering), with hysteresis across frames through a caller-held

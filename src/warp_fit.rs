@@ -24,7 +24,7 @@ const SCALES: [f32; 3] = [1.0, 0.5, 0.0];
 /// samples (and the image's focal length), the warp is also fitted at half its warp
 /// ratio and at none, each measured on them as the quality report measures
 /// (`sample_error`: the 95th percentile of `m` over at most [`AUTO_MAX_SAMPLES`]
-/// front-lit samples, as `auto` ranks its candidates), and the finest is kept (the
+/// front-lit samples, as `auto` first ranks its candidates), and the finest is kept (the
 /// strongest on ties). So a warp is never worse than the uniform fit on the
 /// samples it was given: in a small room seen looking down, under a light from
 /// above, the box predicted the full warps 0.67 to 0.7 times the uniform fit's
