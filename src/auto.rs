@@ -138,12 +138,13 @@ fn measure(
     samples: &Samples<'_>,
     light: LightDirection,
 ) -> [Option<f64>; AUTO_CANDIDATE_COUNT] {
-    let whole = Samples {
+    let more = Samples {
         most: AUTO_CONFIRM_SAMPLES,
         ..*samples
     };
+    // A small frame: every sample at once, and no second measure.
     let samples = if samples.samples.len() <= AUTO_CONFIRM_SAMPLES {
-        &whole
+        &more
     } else {
         samples
     };
@@ -168,10 +169,6 @@ fn measure(
     if samples.samples.len() <= samples.most || again < 2 {
         return measured;
     }
-    let more = Samples {
-        most: AUTO_CONFIRM_SAMPLES,
-        ..*samples
-    };
     let mut confirmed = [None; AUTO_CANDIDATE_COUNT];
     for (i, shadow) in fitted.iter().enumerate() {
         if let (Contender::Again, Some(shadow)) = (contenders[i], shadow) {
@@ -285,6 +282,20 @@ mod tests {
     use crate::sample_error::Unlit;
     use crate::test_views::street_samples;
 
+    /// An eye at head height looking along `forward` down a street 300 m long under
+    /// a receivers' box 40 m tall ([`street_samples`] draws what it sees).
+    fn street_view(forward: Vec3) -> (Camera, Aabb) {
+        let camera = Camera::look_to(
+            Vec3::new(0.0, 1.7, 0.0),
+            forward,
+            Vec3::Y,
+            Projection::perspective(1.0, 1.5, 0.3, 300.0),
+        )
+        .unwrap();
+        let street = Aabb::new(Vec3::new(-40.0, -1.0, -300.0), Vec3::new(40.0, 40.0, 10.0));
+        (camera, street)
+    }
+
     /// A candidate whose subset percentile lies past a knee of its errors (94% of
     /// them fine, the rest twice as coarse) could be the lowest within the subset's
     /// noise, and so could a candidate just above the knee's foot; one far above
@@ -331,16 +342,9 @@ mod tests {
     /// 95th percentile over every front-lit sample, not over a subset.
     #[test]
     fn a_small_frame_is_measured_whole() {
-        let camera = Camera::look_to(
-            Vec3::new(0.0, 1.7, 0.0),
-            Vec3::new(0.05, -0.2, -1.0),
-            Vec3::Y,
-            Projection::perspective(1.0, 1.5, 0.3, 300.0),
-        )
-        .unwrap();
+        let (camera, street) = street_view(Vec3::new(0.05, -0.2, -1.0));
         let direction = Vec3::new(0.3, -1.0, -0.4);
         let light = Light::Directional { direction };
-        let street = Aabb::new(Vec3::new(-40.0, -1.0, -300.0), Vec3::new(40.0, 40.0, 10.0));
         let eye = street_samples(&camera, 48, 32, -40.0);
         assert!(eye.len() > AUTO_MAX_SAMPLES && eye.len() <= AUTO_CONFIRM_SAMPLES);
         let input = FitInput::new(&camera, &light, SceneBounds::whole(street), 512 * 512);
@@ -369,16 +373,9 @@ mod tests {
     /// receivers' box the box's prediction alone picks one that is worse there.
     #[test]
     fn with_eye_samples_auto_keeps_the_candidate_finest_on_them() {
-        let camera = Camera::look_to(
-            Vec3::new(0.0, 1.7, 0.0),
-            Vec3::new(0.05, 0.05, -1.0),
-            Vec3::Y,
-            Projection::perspective(1.0, 1.5, 0.3, 300.0),
-        )
-        .unwrap();
+        let (camera, street) = street_view(Vec3::new(0.05, 0.05, -1.0));
         let direction = Vec3::new(0.0, -1.0, -0.2);
         let light = Light::Directional { direction };
-        let street = Aabb::new(Vec3::new(-40.0, -1.0, -300.0), Vec3::new(40.0, 40.0, 10.0));
         let samples = street_samples(&camera, 96, 64, -40.0);
         let boxed = FitInput::new(&camera, &light, SceneBounds::whole(street), 512 * 512)
             .with_depth_bounds(depth_bounds_of(&camera, &samples));
