@@ -4,6 +4,7 @@
 //! samples instead of rendered pixels.
 
 use arrayvec::ArrayVec;
+use glam::{DVec2, DVec3};
 use shadowmap_frustum::{Camera, FRONT_LIT_MIN_COS, LightDirection, ShadowMapping, math};
 use shadowmap_rtw::{EyeSample, PixelSteps};
 
@@ -54,8 +55,9 @@ impl<'a> Samples<'a> {
 /// its layers having `texels` texels per side; `None` when it covers none. A sample's
 /// surface is its own where the light reaches it from the front (`n . l` at least
 /// `FRONT_LIT_MIN_COS`, as the report measures `m`); elsewhere as `samples.unlit`
-/// says. A sample whose one-pixel neighbours fall outside the map or into another
-/// layer is left out. The pixel steps are `shadowmap_rtw::PixelSteps`, the footprint
+/// says. Where one neighbour half a pixel away along an image axis falls outside
+/// the map or into another layer, the difference to the other one is taken
+/// ([`differentials`]); a sample with neither is left out. The pixel steps are `shadowmap_rtw::PixelSteps`, the footprint
 /// the RTW oracle uses; the texture coordinates' differences are the mapping's
 /// [`uv_differentials`](ShadowMapping::uv_differentials) (the derivative of a matrix
 /// technique's matrix).
@@ -124,6 +126,37 @@ pub(crate) struct PercentileBand {
     pub(crate) high: f64,
 }
 
+/// The half-differences of `mapping`'s texture coordinates across the steps `dx`
+/// and `dy` at `p`: central where `p ± dx` and `p ± dy` fall in `p`'s layer, else,
+/// along an axis whose one neighbour falls in another layer (a sample beside a
+/// paraboloid map's seam or a cube map's edge), the one-sided difference to the
+/// other neighbour, as the quality report differentiates there. Leaving such
+/// samples out drops the rim of a dual paraboloid map, its densest texels, from
+/// every measure of a map whose seam crosses the view.
+fn differentials(
+    mapping: &dyn ShadowMapping,
+    p: DVec3,
+    dx: DVec3,
+    dy: DVec3,
+) -> Option<[DVec2; 2]> {
+    if let Some(j) = mapping.uv_differentials(p, &[p + dx, p - dx, p + dy, p - dy]) {
+        return Some(j);
+    }
+    let layer = mapping.map_point(p)?.layer;
+    let same = |q: DVec3| mapping.map_point(q).is_some_and(|s| s.layer == layer);
+    // Each axis's pair (a one-sided pair spans half the central pair's step).
+    let pair = |d: DVec3| match (same(p + d), same(p - d)) {
+        (true, true) => Some((p + d, p - d, 1.0)),
+        (true, false) => Some((p + d, p, 2.0)),
+        (false, true) => Some((p, p - d, 2.0)),
+        (false, false) => None,
+    };
+    let (x0, x1, sx) = pair(dx)?;
+    let (y0, y1, sy) = pair(dy)?;
+    let [jx, jy] = mapping.uv_differentials(p, &[x0, x1, y0, y1])?;
+    Some([jx * sx, jy * sy])
+}
+
 /// The `percentile` of `values` (reordered) with its band ([`PercentileBand`]),
 /// `None` where [`percentile_of`] is.
 pub(crate) fn percentile_band(values: &mut [f64], percentile: f64) -> Option<PercentileBand> {
@@ -159,7 +192,7 @@ impl Probe {
         // Half-pixel steps each way: the difference across one pixel, twice the
         // mapping's half-differences (an exact doubling).
         let (dx, dy) = self.steps.at(p, n, 2.0 * self.pixels_per_radian)?;
-        let [jx, jy] = mapping.uv_differentials(p, &[p + dx, p - dx, p + dy, p - dy])?;
+        let [jx, jy] = differentials(mapping, p, dx, dy)?;
         let m = 1.0 / math::smaller_singular_value(jx * 2.0 * texels, jy * 2.0 * texels);
         (m.is_finite() && m > 0.0).then_some(m)
     }
@@ -207,6 +240,38 @@ mod tests {
         assert_eq!(error(&behind_the_eye, 1024.0), None);
         let turned_away = [sample(Vec3::new(0.0, 0.0, -10.0), Vec3::NEG_Y)];
         assert!(error(&turned_away, 1024.0).is_some_and(f64::is_finite));
+    }
+
+    /// A sample beside a dual paraboloid map's seam, whose neighbour half a pixel
+    /// below lies in the other layer, is measured with the one-sided difference (as
+    /// the quality report measures it), and its error continues that of a sample
+    /// a dozen pixels from the seam. Left out, the rim of a dual map, its densest
+    /// texels, dropped out of every measure of a map whose seam crosses the view.
+    #[test]
+    fn a_sample_beside_a_seam_is_measured_one_sided() {
+        use shadowmap_frustum::Projection;
+        use shadowmap_paraboloid::{MapOptions, ParaboloidMap};
+        let map = ParaboloidMap::dual(Vec3::ZERO, Vec3::NEG_Y, 0.1, 100.0, &MapOptions::default())
+            .unwrap();
+        let camera = Camera::look_to(
+            Vec3::new(0.0, 0.5, 5.0),
+            Vec3::NEG_Z,
+            Vec3::Y,
+            Projection::perspective(1.0, 1.0, 0.1, 100.0),
+        )
+        .unwrap();
+        let light = LightDirection::Position(Vec3::ZERO);
+        // A wall facing the light; one pixel there spans 15 mm.
+        let error = |y: f32| {
+            let wall = [sample(Vec3::new(0.3, y, -10.0), Vec3::Z)];
+            sample_error(&map, 512.0, &Samples::new(&camera, 1e3, &wall), light, 0.95)
+        };
+        let beside = error(1e-4).expect("a sample beside the seam is measured");
+        let away = error(0.2).unwrap();
+        assert!(
+            (beside / away - 1.0).abs() < 0.05,
+            "{beside} against {away}"
+        );
     }
 
     /// A percentile below a threshold by a clear share of the samples is confident;
