@@ -32,14 +32,20 @@ fn eye_samples<'a>(
     })
 }
 
-/// RTW over the IPSM paraboloid: per side, importance from the eye samples that side
-/// stores, in its `uv`, scaled by the paraboloid's footprint there (world extent of a
-/// unit of `uv` across the ray: `distance / sqrt(uv² per steradian)`), then that
+/// RTW over the IPSM paraboloid: per side, importance from the front-lit eye samples
+/// ([`front_lit`]) that side stores, in its `uv`, scaled by the paraboloid's
+/// footprint there (world extent of a unit of `uv` across the ray:
+/// `distance / sqrt(uv² per steradian)`), then that
 /// side's tables at the strength of least error measured on the samples it stores
 /// (`build_measured_by`, as RTW over a directional light's uniform fit): where
 /// backward analysis misjudges a room's walls, the full warp can lose to the
 /// paraboloid it warps (a lamp beside the eye in a room: 1.16 times the DPSM's
-/// error), and the strength 0 is that paraboloid.
+/// error), and the strength 0 is that paraboloid. The samples the light reaches
+/// from behind are dark whatever the map holds, and the quality report leaves them
+/// out; counted (on the plane facing the bisector of the eye and light
+/// directions), the surfaces turned away from a lamp in a room decided the
+/// strength, and the full warp they chose measured 1.48 times the DPSM's error on
+/// the lit ones (`compare --seed 59 --sweep 64`, random_indoor_room_023).
 ///
 /// The paraboloid warped is the plan's own map and, where the IPSM techniques keep
 /// a dual alternative instead ([`fit_ipsm`]), that one too; the warp whose front-lit
@@ -52,14 +58,15 @@ pub(crate) fn fit_point_rtw(
     plan: &RtwPlan,
     input: &FitInput<'_>,
 ) -> Result<Fitted, FitError> {
-    let samples = eye_samples(input, "point_rtw")?;
     let own = IpsmPlan::new(input.light, input.camera, input.depth_bounds, ipsm)?;
-    let warped_own = warp_paraboloid(own, plan, input, samples)?;
+    let samples = eye_samples(input, "point_rtw")?;
+    let lit = front_lit(samples, LightDirection::Position(own.map.position));
+    let warped_own = warp_paraboloid(own, plan, input, &lit)?;
     let kept = finest_ipsm(own, ipsm, input);
     let Some(ppr) = input.pixels_per_radian.filter(|_| kept.map != own.map) else {
         return Ok(warped_own);
     };
-    let warped_kept = warp_paraboloid(kept, plan, input, samples)?;
+    let warped_kept = warp_paraboloid(kept, plan, input, &lit)?;
     let error = |fitted: &Fitted| match fitted {
         Fitted::PointRtw { plan, front, back } => {
             let mapping = WarpedParaboloid {

@@ -309,13 +309,13 @@
 //! | `point_near` | 4.73 | 2.62 | 1.72 (5 faces) | 2.46 | 1.14 | 0.79 |
 //! | `point_mid` | 28.9 | 13.2 | 7.22 (5 faces) | 18.6 | 1.64 | 1.90 |
 //! | `point_far` | 115 | 55.7 | 25.6 (5 faces) | 97.2 | 2.47 | 3.40 |
-//! | `point_inside` | 5.02 | 4.56 | 4.63 (6 faces) | 5.42 | 1.04 | 1.47 |
+//! | `point_inside` | 5.02 | 4.56 | 4.52 (6 faces) | 5.42 | 1.04 | 1.47 |
 //! | `facing_point` | 18.4 | 15.5 | 10.3 (6 faces) | 23.7 | 1.79 | 1.97 |
 //!
 //! With the light among the visible receivers every face is kept, and six equal maps
 //! of `1024² / 6` texels lose to a DPSM's two of `1024² / 2` (1.08 and 1.29 times its
 //! `m`); sized by need, the faces toward the eye get the texels and the cube has
-//! 0.22 to 0.56 times the DPSM's error, 0.92 times with the light inside the view. The focused fit costs about 0.1 ms with equal faces
+//! 0.22 to 0.56 times the DPSM's error, 0.90 times with the light inside the view. The focused fit costs about 0.1 ms with equal faces
 //! (`cargo bench --bench paraboloid -- cube_fit`: about 8 times an exact IPSM plan on
 //! the shared development machine); sizing by the prediction on the receivers' box
 //! casts a grid of 24 x 14 view rays on top.
