@@ -9,8 +9,11 @@
 //! projection as they are, checked elsewhere once per frame. Ours splits the same
 //! way: `ValidCamera::new` checks the camera once per frame (timed alone), and
 //! `CascadeSet::fit_valid` is the per-light work Bevy's code does (the ratio the
-//! comparison is about). `CascadeSet::fit` does both in one call (a frame with one
-//! light), and is reported too.
+//! comparison is about). A renderer that keeps each light's set (as Bevy keeps each
+//! light's `Cascades`) refits it in place with `CascadeSet::refit_valid`, which
+//! writes the cascades where they are kept instead of returning a new set; both
+//! are timed. `CascadeSet::fit` does the check and the fit in one call (a frame
+//! with one light), and is reported too.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
@@ -131,6 +134,15 @@ fn cascades_vs_bevy(c: &mut Criterion) {
         let set = CascadeSet::fit_valid(black_box(&valid), black_box(light_dir), &splits, o);
         black_box(set.as_ref().unwrap());
     };
+    // Per light, into the set a renderer keeps for the light (as Bevy keeps its
+    // `Cascades` component): refitted in place every frame.
+    let mut kept_stable = CascadeSet::fit_valid(&valid, light_dir, &splits, &stable).unwrap();
+    let mut kept_tight = CascadeSet::fit_valid(&valid, light_dir, &splits, &tight).unwrap();
+    let refit = |set: &mut CascadeSet, o: &CascadeOptions| {
+        let fitted = set.refit_valid(black_box(&valid), black_box(light_dir), &splits, o);
+        fitted.unwrap();
+        black_box(&*set);
+    };
     // Both cover the same slices with maps of the same size.
     let (b, s) = (
         bevy_cascades(),
@@ -152,18 +164,26 @@ fn cascades_vs_bevy(c: &mut Criterion) {
     g.bench_function("tight_fit_4_per_light", |bch| {
         bch.iter(|| per_light(&tight));
     });
+    g.bench_function("stable_refit_4_per_light", |bch| {
+        bch.iter(|| refit(&mut kept_stable, &stable));
+    });
+    g.bench_function("tight_refit_4_per_light", |bch| {
+        bch.iter(|| refit(&mut kept_tight, &tight));
+    });
     g.bench_function("camera_per_frame", |bch| bch.iter(frame));
     g.bench_function("stable_fit_4", |bch| bch.iter(|| ours(&stable)));
     g.bench_function("tight_fit_4", |bch| bch.iter(|| ours(&tight)));
     g.finish();
 
     // One run, interleaved so that a change in the machine's load falls on all.
-    let mut t = [f64::INFINITY; 6];
+    let mut t = [f64::INFINITY; 8];
     for _ in 0..3 {
         let round = [
             timing::min_ns(bevy),
             timing::min_ns(|| per_light(&stable)),
             timing::min_ns(|| per_light(&tight)),
+            timing::min_ns(|| refit(&mut kept_stable, &stable)),
+            timing::min_ns(|| refit(&mut kept_tight, &tight)),
             timing::min_ns(frame),
             timing::min_ns(|| ours(&stable)),
             timing::min_ns(|| ours(&tight)),
@@ -176,6 +196,8 @@ fn cascades_vs_bevy(c: &mut Criterion) {
         t_bevy,
         t_stable,
         t_tight,
+        t_stable_refit,
+        t_tight_refit,
         t_frame,
         t_stable_all,
         t_tight_all,
@@ -185,6 +207,8 @@ fn cascades_vs_bevy(c: &mut Criterion) {
     for (name, ns) in [
         ("stable_fit_4 per light", t_stable),
         ("tight_fit_4 per light", t_tight),
+        ("stable refit_4 per light", t_stable_refit),
+        ("tight refit_4 per light", t_tight_refit),
         ("camera check per frame", t_frame),
         ("stable_fit_4 with check", t_stable_all),
         ("tight_fit_4 with check", t_tight_all),
