@@ -57,8 +57,9 @@ impl<'a> Samples<'a> {
 /// `FRONT_LIT_MIN_COS`, as the report measures `m`); elsewhere as `samples.unlit`
 /// says. Where one neighbour half a pixel away along an image axis falls outside
 /// the map or into another layer, the difference to the other one is taken
-/// ([`differentials`]); a sample with neither is left out. The pixel steps are `shadowmap_rtw::PixelSteps`, the footprint
-/// the RTW oracle uses; the texture coordinates' differences are the mapping's
+/// ([`differentials`]); a sample with neither is left out. The pixel steps are
+/// `shadowmap_rtw::PixelSteps`, the footprint the RTW oracle uses; the texture
+/// coordinates' differences are the mapping's
 /// [`uv_differentials`](ShadowMapping::uv_differentials) (the derivative of a matrix
 /// technique's matrix).
 pub(crate) fn sample_error(
