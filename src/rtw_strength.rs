@@ -45,7 +45,7 @@ pub(crate) fn build_measured(
         let mapping = RtwShadow { base: *base, warps };
         warped_error(&mapping, samples, camera, light)
     };
-    build_measured_by(importance, options, warps, measure)
+    build_measured_by(importance, None, options, warps, measure)
 }
 
 /// The measure [`build_measured`] ranks strengths by: the 95th percentile of `m`
@@ -66,31 +66,42 @@ pub(crate) fn warped_error(
     .unwrap_or(f64::INFINITY)
 }
 
-/// Builds `warps` from `importance` raised to the strength in [`STRENGTHS`] whose
-/// warps `measure` finds the least error (the strongest on ties; the full warp
-/// where no strength measures finite): [`build_measured`] over any base, a
-/// paraboloid side's included.
+/// Builds `warps` from `importance`, or from `alternative` where one is given,
+/// raised to the strength in [`STRENGTHS`] whose warps `measure` finds the least
+/// error (the strongest on ties, `importance` on ties of both; `importance`'s full
+/// warp where nothing measures finite): [`build_measured`] over any base, a
+/// paraboloid side's included, with a choice between two importance maps where the
+/// samples to accumulate are open to question.
 ///
 /// # Errors
 /// The warp builder's errors.
 pub(crate) fn build_measured_by(
     importance: &ImportanceMap,
+    alternative: Option<&ImportanceMap>,
     options: &WarpOptions,
     warps: &mut WarpMaps,
     measure: impl Fn(&WarpMaps) -> f64,
 ) -> Result<(), FitError> {
     let mut raised = ImportanceMap::new(importance.width(), importance.height())?;
-    let mut best: Option<(f64, f32)> = None;
-    for t in STRENGTHS {
-        raise(importance, t, &mut raised)?;
-        warps.build(&raised, options)?;
-        let error = measure(warps);
-        if best.is_none_or(|(e, _)| error <= e) {
-            best = Some((error, t));
+    let candidates = [Some(importance), alternative];
+    let mut best: Option<(f64, usize, f32)> = None;
+    for (c, map) in candidates.iter().enumerate() {
+        let Some(map) = map else { continue };
+        for t in STRENGTHS {
+            raise(map, t, &mut raised)?;
+            warps.build(&raised, options)?;
+            let error = measure(warps);
+            if best.is_none_or(|(e, b, _)| error < e || (error == e && c == b)) {
+                best = Some((error, c, t));
+            }
         }
     }
-    let t = best.map_or(1.0, |(e, t)| if e.is_finite() { t } else { 1.0 });
-    raise(importance, t, &mut raised)?;
+    let (map, t) = match best {
+        Some((e, 1, t)) if e.is_finite() => (alternative.unwrap_or(importance), t),
+        Some((e, _, t)) if e.is_finite() => (importance, t),
+        _ => (importance, 1.0),
+    };
+    raise(map, t, &mut raised)?;
     warps.build(&raised, options)?;
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! Tests of the point-light fits.
 
+use super::face_budget::{axis_percentiles, face_shapes, size_for_lit};
 use super::*;
 use crate::{Technique, fit};
 use glam::Vec3;
@@ -110,76 +111,6 @@ fn cell_densities_give_up_the_costliest_samples() {
     assert_eq!(cell_densities(&mut few, 2), vec![2.0, 7.0]);
 }
 
-/// Texels of densities (the sum of their squares).
-fn texels(densities: &[f64]) -> f64 {
-    densities.iter().map(|d| d * d).sum()
-}
-
-/// The faces' densities are the least texels that serve all but 5% of the
-/// samples: equal to a brute force over how many each face gives up, on random
-/// needs; and where a face's largest needs are many and alike (no single sample
-/// given up saves anything), fewer than the greedy choice of the largest saving.
-#[test]
-fn face_densities_are_the_least_texels_that_serve_the_percentile() {
-    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
-    for _ in 0..40 {
-        let faces = 1 + (next() * 4.0) as usize;
-        let mut needs: Vec<(usize, f64)> = (0..60)
-            .map(|_| {
-                (
-                    (next() * faces as f64) as usize,
-                    1.0 + 100.0 * next() * next(),
-                )
-            })
-            .collect();
-        let found = face_densities(&mut needs.clone(), faces);
-        // Brute force: every way of giving up at most 3 samples (5% of 60).
-        let mut all: Vec<f64> = needs.iter().map(|n| n.1).collect();
-        let common = percentile(&mut all).unwrap();
-        needs.sort_by(|a, b| a.0.cmp(&b.0).then(b.1.total_cmp(&a.1)));
-        let of_face =
-            |f: usize| -> Vec<f64> { needs.iter().filter(|n| n.0 == f).map(|n| n.1).collect() };
-        let density = |face: &[f64], k: usize| {
-            face.first().map_or(0.0, |top| {
-                face.get(k)
-                    .copied()
-                    .unwrap_or(0.0)
-                    .max(GIVEN_UP_FLOOR * top.min(common))
-            })
-        };
-        let mut least = f64::INFINITY;
-        for code in 0..4usize.pow(faces as u32) {
-            let ks: Vec<usize> = (0..faces)
-                .map(|f| code / 4usize.pow(f as u32) % 4)
-                .collect();
-            if ks.iter().sum::<usize>() <= 3 {
-                let d: Vec<f64> = (0..faces).map(|f| density(&of_face(f), ks[f])).collect();
-                least = least.min(texels(&d));
-            }
-        }
-        assert!(
-            (texels(&found) - least).abs() <= 1e-9 * least,
-            "{found:?}: {least}"
-        );
-    }
-    // Face 0: ten samples needing 100 and ninety needing 50; face 1: a hundred
-    // needing 90 down to 80.5. Ten may be given up: all of face 0's top saves
-    // 100² - 50² where the greedy choice gives up face 1's top for 0.1 steps.
-    let mut needs: Vec<(usize, f64)> = (0..10).map(|_| (0, 100.0)).collect();
-    needs.extend((0..90).map(|_| (0, 50.0)));
-    needs.extend((0..100).map(|i| (1, 90.0 - 0.1 * f64::from(i))));
-    let exact = face_densities(&mut needs.clone(), 2);
-    assert_eq!(exact.as_slice(), &[50.0, 90.0]);
-    let greedy = cell_densities(&mut needs, 2);
-    assert!(texels(&greedy) > 1.3 * texels(&exact), "{greedy:?}");
-}
-
 /// The cases `generate` makes of up to `count` blocks of xorshift bytes from `seed`.
 fn generated<T>(
     seed: u64,
@@ -267,39 +198,57 @@ fn point_rtw_is_never_worse_than_its_paraboloid_on_its_samples() {
     assert!(checked > 50, "{checked} sides checked");
 }
 
-/// RTW over the paraboloid reads the front-lit samples only: the others are dark
-/// whatever the map holds and the quality report leaves them out, so fitting
-/// without them gives the same tables. (Counted on the plane facing the bisector,
-/// the walls turned away from a lamp chose a full warp 1.48 times the DPSM's error
-/// on the lit ones.)
+/// RTW over the paraboloid measures its warps on the front-lit samples (the
+/// others are dark whatever the map holds, and the quality report leaves them
+/// out), and chooses between the importance of the front-lit samples and that of
+/// all of them: on the front-lit samples each side's tables are never worse than
+/// either importance's full warp, and both importances are the finer one in some
+/// cases.
 #[test]
-fn point_rtw_reads_only_the_front_lit_samples() {
-    let (mut checked, mut with_unlit) = (0, 0);
+fn point_rtw_keeps_the_finer_importance_on_the_front_lit_samples() {
+    let (mut checked, mut lit_finer, mut all_finer) = (0, 0, 0);
     for case in point_cases(0x7c3e_91a5_0d26_e4b9, 200) {
         let input = point_input(&case);
         let rtw = RtwPlan::default().with_importance_side(32);
         let options = case.plan.options;
-        let Ok(Fitted::PointRtw { front, back, .. }) = fit_point_rtw(&options, &rtw, &input) else {
+        let Ok(Fitted::PointRtw { plan, front, back }) = fit_point_rtw(&options, &rtw, &input)
+        else {
             continue;
         };
-        let light = LightDirection::Position(own_plan(&case).map.position);
+        let light = LightDirection::Position(plan.map.position);
         let lit = front_lit(&case.samples, light);
-        let lit_only = point_input(&case).with_eye_samples(&lit);
-        let Ok(Fitted::PointRtw {
-            front: lit_front,
-            back: lit_back,
-            ..
-        }) = fit_point_rtw(&options, &rtw, &lit_only)
-        else {
-            panic!("fits on all samples, not on the lit ones");
-        };
-        assert_eq!((front, back), (lit_front, lit_back));
-        checked += 1;
-        with_unlit += usize::from(lit.len() < case.samples.len());
+        if lit.len() == case.samples.len() {
+            continue;
+        }
+        for (side, chosen) in [(Side::Front, Some(&front)), (Side::Back, back.as_ref())] {
+            let Some(chosen) = chosen else { continue };
+            let map = &plan.map;
+            let error = |warps: &WarpMaps| {
+                let mapping = WarpedSide { map, side, warps };
+                warped_error(&mapping, &lit, &case.plan.camera, light)
+            };
+            let full = |samples: &[EyeSample]| {
+                let importance = side_importance(map, side, samples, &rtw).unwrap();
+                let mut warps = WarpMaps::new(32, 32).unwrap();
+                warps.build(&importance, &rtw.warp).unwrap();
+                error(&warps)
+            };
+            let (e, from_lit, from_all) = (error(chosen), full(&lit), full(&case.samples));
+            if !e.is_finite() {
+                continue;
+            }
+            assert!(
+                e <= from_lit.min(from_all) * (1.0 + 1e-9),
+                "{e} kept, {from_lit} and {from_all} on offer"
+            );
+            checked += 1;
+            lit_finer += usize::from(from_lit < from_all);
+            all_finer += usize::from(from_all < from_lit);
+        }
     }
     assert!(
-        checked > 50 && with_unlit > 10,
-        "{checked} cases, {with_unlit} with unlit samples"
+        checked > 30 && lit_finer > 3 && all_finer > 3,
+        "{checked} sides, the lit samples' finer on {lit_finer}, all samples' on {all_finer}"
     );
 }
 
@@ -362,8 +311,8 @@ fn point_rtw_keeps_the_finer_of_its_two_bases() {
             continue;
         }
         let lit = front_lit(&case.samples, LightDirection::Position(plan.map.position));
-        let over_own = warp_paraboloid(plan, &rtw, &input, &lit).unwrap();
-        let over_kept = warp_paraboloid(kept, &rtw, &input, &lit).unwrap();
+        let over_own = warp_paraboloid(plan, &rtw, &input, &case.samples, &lit).unwrap();
+        let over_kept = warp_paraboloid(kept, &rtw, &input, &case.samples, &lit).unwrap();
         let (e, a, b) = (error(&chosen), error(&over_own), error(&over_kept));
         assert!(e <= a.min(b), "{e} kept, {a} and {b} on offer");
         own += usize::from(e == a && a < b);
@@ -467,4 +416,137 @@ proptest! {
     fn point_rtw_covers_what_the_paraboloid_covers(case in strategy(point_rtw_case)) {
         fit_and_check(&case);
     }
+}
+
+/// RTW over the cube faces sizes its faces for the front-lit samples (the ones the
+/// quality report measures): with the surfaces one face stores turned away from the
+/// light, that face keeps the floor (a sixteenth of the largest face's side, and
+/// what the packing leaves), below the quarter of the largest side that sizes
+/// for the samples' needs would give it at least.
+#[test]
+fn cube_rtw_sizes_its_faces_for_the_front_lit_samples() {
+    let mut floored = 0;
+    for mut case in cube_cases(0x51d3_8a0e_c4b7_2f69, 600) {
+        let rtw = RtwPlan::default().with_importance_side(32);
+        let fitted = |case: &CubeSamplesCase| match fit_cube_rtw(
+            &case.cube.options,
+            &rtw,
+            &cube_input(case, 1 << 16),
+        ) {
+            Ok(Fitted::CubeRtw { cube, .. }) => Some(cube),
+            _ => None,
+        };
+        let Some(cube) = fitted(&case) else { continue };
+        // The face that stores the most samples, among at least two that store some.
+        let counts: Vec<usize> = samples_by_face(&cube, &case.samples)
+            .iter()
+            .map(Vec::len)
+            .collect();
+        let Some((face, _)) = counts.iter().enumerate().max_by_key(|(_, n)| **n) else {
+            continue;
+        };
+        if counts.iter().filter(|n| **n > 20).count() < 2 {
+            continue;
+        }
+        let light = cube.position;
+        for s in &mut case.samples {
+            if cube
+                .map_point(s.position.as_dvec3())
+                .is_some_and(|x| x.layer as usize == face)
+            {
+                s.normal = (s.position - light).normalize_or_zero();
+            }
+        }
+        let Some(turned) = fitted(&case) else {
+            continue;
+        };
+        let (side, largest) = (
+            turned.faces[face].size[0].max(turned.faces[face].size[1]),
+            turned.largest_side(),
+        );
+        assert!(
+            f64::from(side) < shadowmap_paraboloid::MIN_SIDE_RATIO * f64::from(largest),
+            "{side} of {largest}, {:?} before, {:?} after, face {face}",
+            cube.faces.iter().map(|f| f.size).collect::<Vec<_>>(),
+            turned.faces.iter().map(|f| f.size).collect::<Vec<_>>()
+        );
+        floored += 1;
+    }
+    assert!(floored > 15, "{floored} faces turned away");
+}
+
+/// RTW over the cube faces keeps, of its candidate sizes, the one whose packed
+/// faces leave the front-lit samples the least error: on random needs of the
+/// faces of generated cubes, never more than the least texels' shapes
+/// ([`face_shapes`]) or sizes for equal error per face, and each of the two is
+/// the finer one after packing in some cases.
+#[test]
+fn cube_rtw_keeps_the_finest_packed_sizes() {
+    let (mut checked, mut shaped_finer, mut equal_finer) = (0, 0, 0);
+    let mut next = {
+        let mut state = 0x3c6e_f372_fe94_f82b_u64;
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    };
+    for case in cube_cases(0x6a09_e667_f3bc_c908, 100) {
+        let input = cube_input(&case, 1 << 16);
+        let Ok(cube) = fit_faces(&case.cube.options, &input) else {
+            continue;
+        };
+        let faces = cube.faces.len();
+        if faces < 2 {
+            continue;
+        }
+        // Each face's samples need along `u` and `v` in its own proportion.
+        let shape: Vec<[f64; 2]> = (0..faces)
+            .map(|_| [1.0 + 9.0 * next(), 1.0 + 9.0 * next()])
+            .collect();
+        let mut needs: Vec<(usize, [f64; 2])> = (0..400)
+            .map(|_| {
+                let f = (next() * faces as f64) as usize;
+                let s = 1.0 + 20.0 * next() * next();
+                (f, [s * shape[f][0], s * shape[f][1] * (0.5 + next())])
+            })
+            .collect();
+        let equal: ArrayVec<Option<[f64; 2]>, 6> = (0..faces)
+            .map(|f| {
+                axis_percentiles(
+                    &needs.iter().filter(|n| n.0 == f).map(|n| n.1),
+                    &mut Vec::new(),
+                )
+            })
+            .collect();
+        let shaped = face_shapes(&mut needs, faces);
+        let error = |candidates: &[(&[Option<[f64; 2]>], f64)]| {
+            let mut sized = cube.clone();
+            size_for_lit(&mut sized, candidates, &needs, 1 << 16);
+            assert!(sized.texels() <= 1 << 16);
+            let mut e: Vec<f64> = needs
+                .iter()
+                .map(|(f, n)| {
+                    let s = sized.faces[*f].size.map(f64::from);
+                    (n[0] / s[0]).max(n[1] / s[1])
+                })
+                .collect();
+            percentile(&mut e).unwrap()
+        };
+        let (a, b) = (&shaped[..], &equal[..]);
+        let kept = error(&[(a, 1.0 / 16.0), (b, 1.0 / 16.0)]);
+        let (from_shaped, from_equal) = (error(&[(a, 1.0 / 16.0)]), error(&[(b, 1.0 / 16.0)]));
+        assert!(
+            kept <= from_shaped.min(from_equal),
+            "{kept} kept, {from_shaped} and {from_equal} on offer"
+        );
+        checked += 1;
+        shaped_finer += usize::from(from_shaped < from_equal);
+        equal_finer += usize::from(from_equal < from_shaped);
+    }
+    assert!(
+        checked > 30 && shaped_finer > 3 && equal_finer > 2,
+        "{checked} cases, the least texels finer in {shaped_finer}, equal errors in {equal_finer}"
+    );
 }

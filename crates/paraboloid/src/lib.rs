@@ -306,11 +306,11 @@
 //!
 //! | configuration | DPSM | IPSM exact | cube, by need | cube, equal full faces | RTW over the faces | tiled |
 //! |---|---|---|---|---|---|---|
-//! | `point_near` | 4.73 | 2.62 | 1.72 (5 faces) | 2.46 | 1.14 | 0.79 |
-//! | `point_mid` | 28.9 | 13.2 | 7.22 (5 faces) | 18.6 | 1.64 | 1.90 |
-//! | `point_far` | 115 | 55.7 | 25.6 (5 faces) | 97.2 | 2.47 | 3.40 |
-//! | `point_inside` | 5.02 | 4.56 | 4.52 (6 faces) | 5.42 | 1.04 | 1.47 |
-//! | `facing_point` | 18.4 | 15.5 | 10.3 (6 faces) | 23.7 | 1.79 | 1.97 |
+//! | `point_near` | 4.73 | 2.62 | 1.72 (5 faces) | 2.46 | 1.11 | 0.79 |
+//! | `point_mid` | 28.9 | 13.2 | 7.22 (5 faces) | 18.6 | 1.48 | 1.90 |
+//! | `point_far` | 115 | 55.7 | 25.6 (5 faces) | 97.2 | 2.12 | 3.40 |
+//! | `point_inside` | 5.02 | 4.56 | 4.52 (6 faces) | 5.42 | 1.03 | 1.47 |
+//! | `facing_point` | 18.4 | 15.5 | 10.3 (6 faces) | 23.7 | 1.57 | 1.97 |
 //!
 //! With the light among the visible receivers every face is kept, and six equal maps
 //! of `1024² / 6` texels lose to a DPSM's two of `1024² / 2` (1.08 and 1.29 times its
