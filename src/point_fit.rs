@@ -257,7 +257,7 @@ fn finest_ipsm(plan: IpsmPlan, options: &IpsmOptions, input: &FitInput<'_>) -> I
 /// side) instead of the prediction on the receivers' box, which misjudges a face
 /// when the box is far from the surfaces (a terrain's box reaches the sky). The
 /// sides are the least texels that serve all but `1 - NEED_PERCENTILE` of the
-/// samples over all faces ([`cell_densities`], each face a cell): the 95th
+/// samples over all faces ([`face_densities`], found exactly over the faces): the 95th
 /// percentile over the view, not each face's own. Equal errors per face would let
 /// a face that a few pixels see at a grazing angle (a wall beside a lamp) take
 /// most of the budget from the faces most pixels see.
