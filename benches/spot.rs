@@ -2,9 +2,11 @@
 //! the fits they refine: RTW over the spot fit (backward importance of a G-buffer's
 //! worth of eye samples into a 256² map, warp tables, both reused across frames) and
 //! the whole `shadowmap::fit` of it (which allocates its map and tables) against the
-//! spot fit; RTW over the IPSM paraboloid through `shadowmap::fit` against the IPSM
-//! plan. Besides criterion's figures it prints each one's time per call (the fastest
-//! of many short batches, see `support/timing.rs`) and its ratio to its base fit.
+//! spot fit, again with a quarter of the samples turned away from the spot (two
+//! importance maps measured); RTW over the IPSM paraboloid through `shadowmap::fit`
+//! against the IPSM plan. Besides criterion's figures it prints each one's time per
+//! call (the fastest of many short batches, see `support/timing.rs`) and its ratio to
+//! its base fit.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
@@ -103,6 +105,21 @@ fn spot(c: &mut Criterion) {
     let input = FitInput::new(&f.camera, &f.spot, f.scene, 1 << 20).with_eye_samples(&f.samples);
     let technique = Technique::SpotRtw(RtwPlan::default());
     let umbrella = || fit(&technique, &input).unwrap();
+    // The same G-buffer with every fourth sample on a surface turned away from the
+    // spot (facing the camera, the spot behind it): RTW then also accumulates every
+    // sample's importance and measures both maps' strengths.
+    let partly_lit: Vec<EyeSample> = f
+        .samples
+        .iter()
+        .enumerate()
+        .map(|(i, s)| EyeSample {
+            normal: if i % 4 == 0 { Vec3::Z } else { s.normal },
+            ..*s
+        })
+        .collect();
+    let partly_lit_input =
+        FitInput::new(&f.camera, &f.spot, f.scene, 1 << 20).with_eye_samples(&partly_lit);
+    let umbrella_partly_lit = || fit(&technique, &partly_lit_input).unwrap();
 
     let bounds = shadowmap::depth_bounds_of(&f.camera, &f.samples);
     let ipsm = IpsmOptions::default().with_fit(ConeFit::Exact);
@@ -132,6 +149,12 @@ fn spot(c: &mut Criterion) {
             spot_ns,
             "spot fit",
         ),
+        (
+            "the same, a quarter of samples unlit",
+            timing::min_ns(umbrella_partly_lit),
+            spot_ns,
+            "spot fit",
+        ),
         ("IPSM plan (exact cone)", ipsm_ns, ipsm_ns, "IPSM plan"),
         (
             "point RTW through shadowmap::fit",
@@ -156,6 +179,9 @@ fn spot(c: &mut Criterion) {
     g.bench_function("spot_fit", |b| b.iter(|| black_box(spot_fit())));
     g.bench_function("spot_rtw", |b| b.iter(|| black_box(spot_rtw())));
     g.bench_function("spot_rtw_fit", |b| b.iter(|| black_box(umbrella())));
+    g.bench_function("spot_rtw_fit_partly_lit", |b| {
+        b.iter(|| black_box(umbrella_partly_lit()));
+    });
     g.bench_function("ipsm_plan", |b| b.iter(|| black_box(ipsm_plan())));
     g.bench_function("point_rtw_fit", |b| b.iter(|| black_box(point_rtw())));
     g.finish();

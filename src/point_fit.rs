@@ -66,13 +66,15 @@ pub(crate) fn fit_point_rtw(
 ) -> Result<Fitted, FitError> {
     let own = IpsmPlan::new(input.light, input.camera, input.depth_bounds, ipsm)?;
     let samples = eye_samples(input, "point_rtw")?;
-    let lit = front_lit(samples, LightDirection::Position(own.map.position));
-    let warped_own = warp_paraboloid(own, plan, input, samples, &lit)?;
+    let light = LightDirection::Position(own.map.position);
+    let (lit, unlit): (Vec<EyeSample>, Vec<EyeSample>) =
+        samples.iter().partition(|s| is_front_lit(s, light));
+    let warped_own = warp_paraboloid(own, plan, input, &lit, &unlit)?;
     let kept = finest_ipsm(own, ipsm, input);
     let Some(ppr) = input.pixels_per_radian.filter(|_| kept.map != own.map) else {
         return Ok(warped_own);
     };
-    let warped_kept = warp_paraboloid(kept, plan, input, samples, &lit)?;
+    let warped_kept = warp_paraboloid(kept, plan, input, &lit, &unlit)?;
     let error = |fitted: &Fitted| match fitted {
         Fitted::PointRtw { plan, front, back } => {
             let mapping = WarpedParaboloid {
@@ -111,21 +113,26 @@ pub(crate) fn front_lit_error(
 }
 
 /// RTW's tables over each side of `ipsm`'s map (see [`fit_point_rtw`]), from the
-/// importance of the `lit` samples or of `all` of them, measured on the `lit` ones.
+/// importance of the `lit` samples or of all of them (`unlit` the others),
+/// measured on the `lit` ones.
 fn warp_paraboloid(
     ipsm: IpsmPlan,
     plan: &RtwPlan,
     input: &FitInput<'_>,
-    all: &[EyeSample],
     lit: &[EyeSample],
+    unlit: &[EyeSample],
 ) -> Result<Fitted, FitError> {
     let map = ipsm.map;
     let n = plan.importance_side;
     let side_warps = |side: Side| -> Result<WarpMaps, FitError> {
-        let accumulated = |samples| side_importance(&map, side, samples, plan);
-        let importance = accumulated(lit)?;
-        let alternative = (all.len() > lit.len())
-            .then(|| accumulated(all))
+        let importance = side_importance(&map, side, lit, plan)?;
+        // Each cell holds the largest of its samples' importance: every sample's
+        // map is the lit samples' raised by the others'.
+        let alternative = (!unlit.is_empty())
+            .then(|| {
+                let mut all = importance.clone();
+                accumulate_side(&map, side, unlit, plan, &mut all).map(|()| all)
+            })
             .transpose()?;
         let mut warps = WarpMaps::new(n, n)?;
         let light = LightDirection::Position(map.position);
@@ -167,6 +174,21 @@ fn side_importance(
     samples: &[EyeSample],
     plan: &RtwPlan,
 ) -> Result<ImportanceMap, FitError> {
+    let n = plan.importance_side;
+    let mut importance = ImportanceMap::new(n, n)?;
+    accumulate_side(map, side, samples, plan, &mut importance)?;
+    Ok(importance)
+}
+
+/// Raises the cells of `importance` (over `side` of `map`) to the backward-analysis
+/// importance of `samples`, as [`side_importance`] accumulates it.
+fn accumulate_side(
+    map: &ParaboloidMap,
+    side: Side,
+    samples: &[EyeSample],
+    plan: &RtwPlan,
+    importance: &mut ImportanceMap,
+) -> Result<(), FitError> {
     let project = |p: DVec3| {
         let s = map.map_point(p).filter(|s| s.layer == side.layer())?;
         let world = p.as_vec3();
@@ -178,10 +200,8 @@ fn side_importance(
             toward_light,
         })
     };
-    let n = plan.importance_side;
-    let mut importance = ImportanceMap::new(n, n)?;
     importance.accumulate_backward_with(project, samples, None, &plan.importance)?;
-    Ok(importance)
+    Ok(())
 }
 
 /// Both sides of a paraboloid map, each warped by its tables: RTW over the

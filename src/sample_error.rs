@@ -202,13 +202,18 @@ impl Probe {
 /// The `percentile` of `values` (reordered), `None` when empty or not positive and
 /// finite.
 pub(crate) fn percentile_of(values: &mut [f64], percentile: f64) -> Option<f64> {
-    let count = values.len();
-    if count == 0 {
+    if values.is_empty() {
         return None;
     }
-    let rank = ((percentile * count as f64).ceil() as usize).clamp(1, count) - 1;
+    let rank = percentile_rank(values.len(), percentile);
     let (_, x, _) = values.select_nth_unstable_by(rank, f64::total_cmp);
     (x.is_finite() && *x > 0.0).then_some(*x)
+}
+
+/// The index, in ascending order, of the `percentile` of `count > 0` values: the
+/// smallest value with at least that share of the values at or below it.
+pub(crate) fn percentile_rank(count: usize, percentile: f64) -> usize {
+    ((percentile * count as f64).ceil() as usize).clamp(1, count.max(1)) - 1
 }
 
 #[cfg(test)]

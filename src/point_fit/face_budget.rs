@@ -11,7 +11,7 @@ use shadowmap_paraboloid::{CubeMap, MIN_SIDE_RATIO};
 use shadowmap_rtw::{AxisNeed, WarpMaps};
 
 use super::{GIVEN_UP_FLOOR, MEASURED_MIN_SIDE_RATIO, NEED_PERCENTILE};
-use crate::sample_error::MAX_SAMPLES;
+use crate::sample_error::{MAX_SAMPLES, percentile_rank};
 
 /// Most samples the faces give up together: their share of [`MAX_SAMPLES`].
 const MAX_FACE_DROPS: usize = MAX_SAMPLES / 20;
@@ -31,8 +31,8 @@ fn common_need(values: &mut [f64]) -> f64 {
     if values.is_empty() {
         return 0.0;
     }
-    let rank = ((NEED_PERCENTILE * values.len() as f64).ceil() as usize).clamp(1, values.len());
-    *values.select_nth_unstable_by(rank - 1, f64::total_cmp).1
+    let rank = percentile_rank(values.len(), NEED_PERCENTILE);
+    *values.select_nth_unstable_by(rank, f64::total_cmp).1
 }
 
 /// A face's density with its `k` largest needs given up, from `need(i)`, its
@@ -107,9 +107,9 @@ pub(super) fn face_densities(needs: &mut [(usize, f64)], faces: usize) -> ArrayV
     let common = if needs.is_empty() {
         0.0
     } else {
-        let rank = ((NEED_PERCENTILE * needs.len() as f64).ceil() as usize).clamp(1, needs.len());
+        let rank = percentile_rank(needs.len(), NEED_PERCENTILE);
         needs
-            .select_nth_unstable_by(rank - 1, |a, b| a.1.total_cmp(&b.1))
+            .select_nth_unstable_by(rank, |a, b| a.1.total_cmp(&b.1))
             .1
             .1
     };

@@ -310,9 +310,11 @@ fn point_rtw_keeps_the_finer_of_its_two_bases() {
         if kept.map == plan.map {
             continue;
         }
-        let lit = front_lit(&case.samples, LightDirection::Position(plan.map.position));
-        let over_own = warp_paraboloid(plan, &rtw, &input, &case.samples, &lit).unwrap();
-        let over_kept = warp_paraboloid(kept, &rtw, &input, &case.samples, &lit).unwrap();
+        let light = LightDirection::Position(plan.map.position);
+        let (lit, unlit): (Vec<EyeSample>, Vec<EyeSample>) =
+            case.samples.iter().partition(|s| is_front_lit(s, light));
+        let over_own = warp_paraboloid(plan, &rtw, &input, &lit, &unlit).unwrap();
+        let over_kept = warp_paraboloid(kept, &rtw, &input, &lit, &unlit).unwrap();
         let (e, a, b) = (error(&chosen), error(&over_own), error(&over_kept));
         assert!(e <= a.min(b), "{e} kept, {a} and {b} on offer");
         own += usize::from(e == a && a < b);
