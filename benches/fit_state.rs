@@ -4,7 +4,9 @@
 //! count chosen from the predicted error (the tight and stable ones also given the
 //! eye samples of a 160 x 90 G-buffer, which they measure each count on), and
 //! `auto`, which fits all seven candidates and predicts their error (or, given the
-//! samples, measures it on them); each beside the uniform fit timed in the same run. Besides
+//! samples, measures it on them), and the stable cascades from a fresh state (every
+//! map sized, its orientation ranked on the samples where given); each beside the
+//! uniform fit timed in the same run. Besides
 //! criterion's figures it prints each fit's time per call (the fastest of many short
 //! batches, see `support/timing.rs`) and its ratio to the uniform fit. `FIT_STATE_ONLY`
 //! runs one fit for instruction counting (see `only`).
@@ -135,6 +137,18 @@ fn fits(c: &mut Criterion) {
             b.iter(|| fit_with_state(black_box(technique), black_box(input), &mut state));
         });
     }
+    // A fresh state each call: what a frame that (re)sizes every stable map costs,
+    // its new orientations ranked on the samples where it has them.
+    let stable = Technique::StableCascades(plan);
+    let fresh = [
+        ("stable_fresh", &input),
+        ("stable_on_samples_fresh", &sampled),
+    ];
+    for (name, input) in fresh {
+        group.bench_function(name, |b| {
+            b.iter(|| fit_with_state(&stable, black_box(input), &mut FitState::default()));
+        });
+    }
     group.finish();
     let time = |technique: &Technique, input: &FitInput<'_>| {
         let mut state = FitState::default();
@@ -144,6 +158,14 @@ fn fits(c: &mut Criterion) {
     println!("\nper-frame fit_with_state, fastest batch (same run):");
     for (name, technique, input) in &techniques {
         let ns = time(technique, input);
+        println!(
+            "  {name:<16} {:>9.1} us  {:>6.1}x uniform",
+            ns / 1e3,
+            ns / uniform
+        );
+    }
+    for (name, input) in fresh {
+        let ns = timing::min_ns(|| fit_with_state(&stable, input, &mut FitState::default()));
         println!(
             "  {name:<16} {:>9.1} us  {:>6.1}x uniform",
             ns / 1e3,

@@ -4,8 +4,7 @@ use arrayvec::ArrayVec;
 use shadowmap_frustum::{LightDirection, ShadowMapping};
 use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 
-use crate::cascaded::CountChoice;
-use crate::fit::{FitError, FitInput, FitState, fit_candidate_with, predicted_percentiles};
+use crate::fit::{FitError, FitInput, FitState, fit_candidate, predicted_percentiles};
 use crate::sample_error::{PercentileBand, Samples, percentile_band, sample_error, sample_errors};
 use crate::shadow::Shadow;
 use crate::technique::{CascadePlan, Technique};
@@ -38,12 +37,13 @@ pub fn auto_candidates(plan: &CascadePlan) -> [Technique; AUTO_CANDIDATE_COUNT] 
 /// Most eye samples `auto` measures each candidate on first (a regular subset of
 /// the frame's): the candidates that could still be the best within that subset's
 /// noise are then measured again on more ([`AUTO_CONFIRM_SAMPLES`]; a frame with no
-/// more samples than that is measured whole at once). With the tight
-/// cascades' count and the warps' strengths measured on the same samples, `auto`
-/// on a 160 x 90 G-buffer's samples takes about 1.4 ms a frame in all (`cargo bench
-/// --bench fit_state`: `auto_on_samples`, 455 times the uniform fit; 0.8 ms with
-/// the warps at their predicted strength only, which measured 1.2 times the best
-/// technique over a fence at seed 14).
+/// more samples than that is measured whole at once). With the cascades' counts,
+/// the stable maps' orientations and the warps' strengths measured on the same
+/// samples, `auto` on a 160 x 90 G-buffer's samples takes about 1.26 ms a frame in
+/// all (`cargo bench --bench fit_state`: `auto_on_samples`, about 680 times the
+/// uniform fit). The warps at their predicted strength only took 0.8 ms against
+/// 1.4 ms when that was measured, and measured 1.2 times the best technique over
+/// a fence at seed 14.
 pub const AUTO_MAX_SAMPLES: usize = 512;
 
 /// `auto`: fits every candidate, ranks them by their 95th-percentile aliasing error,
@@ -70,22 +70,16 @@ pub(crate) fn fit_auto(
 ) -> Result<Shadow, FitError> {
     let candidates = auto_candidates(plan);
     let mut fitted: [Option<Shadow>; AUTO_CANDIDATE_COUNT] = Default::default();
-    let mut tight_fitted = false;
     // The warps and warped cascades back off on the samples as they do alone
     // (half their warp ratio, or none): fitted at their predicted strength only, a
     // warp the samples would back off half way is not among the candidates, and
-    // `auto` measured 1.2 times TSM (which did) over a fence at seed 14.
+    // `auto` measured 1.2 times TSM (which did) over a fence at seed 14. The stable
+    // cascades choose their count on their own error, as alone: with the tight
+    // cascades' count instead, a stable map turned along a fence's footprint (one
+    // map, 2.6) stood in `auto` as four maps (4.5, `compare --seed 81 --sweep 64`,
+    // random_fence_018).
     for (slot, technique) in fitted.iter_mut().zip(&candidates) {
-        // The stable cascades' count is predicted by the same tight fits as the
-        // tight cascades': fitted after them, they keep the count just chosen.
-        let count = match technique {
-            Technique::StableCascades(_) if tight_fitted => CountChoice::Keep,
-            _ => CountChoice::Predict,
-        };
-        *slot = fit_candidate_with(technique, input, state, count).ok();
-        if matches!(technique, Technique::TightCascades(_)) {
-            tight_fitted = slot.is_some();
-        }
+        *slot = fit_candidate(technique, input, state).ok();
     }
     let percentiles = match directional_samples(input) {
         Some((samples, light)) if !samples.samples.is_empty() => {

@@ -10,22 +10,11 @@ use shadowmap_frustum::{
 use shadowmap_warp::{LispsmOptions, WarpedCascades, light_frame, warped_cascades};
 
 use crate::fit::{FitError, FitInput, predictions};
+use crate::held_orientation::least_error_on;
 use crate::sample_error::{confidently_at_most, percentile_of, sample_error, sample_errors};
 use crate::shadow::Fitted;
 use crate::technique::CascadePlan;
 use crate::warp_fit::{directional_samples, finest_strength};
-
-/// How a cascaded fit gets its count.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum CountChoice {
-    /// Predicted this frame ([`choose_splits`]).
-    Predict,
-    /// The count in the state, predicted this frame by another fit (`auto` fits
-    /// the tight cascades, then the stable ones with the count the tight ones just
-    /// predicted: one prediction less per frame, and `auto` measures every
-    /// candidate it fits anyway).
-    Keep,
-}
 
 /// Stable or tight cascades (PSSM over the depth bounds), their count chosen by
 /// [`choose_splits`] on their own predicted error and kept in `state` with the
@@ -36,7 +25,6 @@ pub(crate) fn fit_cascades(
     direction: Vec3,
     input: &FitInput<'_>,
     state: &mut CascadeState,
-    choice: CountChoice,
 ) -> Result<(Fitted, u32), FitError> {
     let camera = ValidCamera::new(input.camera)?;
     let (near, far) = depth_range(input, &camera);
@@ -51,18 +39,31 @@ pub(crate) fn fit_cascades(
     // Each count is predicted as it would be fitted: the stable cascades from a copy
     // of the held maps, so the prediction leaves `state` as it found it.
     let held = *state;
+    // A stable map's new orientation, where the footprint offers rivals to the
+    // view's frame, is chosen on the eye's samples where there are any.
+    let samples = directional_samples(input);
+    let fit_stable = |splits: &CascadeSplits, options: &CascadeOptions, into: &mut CascadeState| {
+        match &samples {
+            Some((samples, light)) => {
+                let side = f64::from(options.resolution);
+                let rank = least_error_on(samples, *light, side, input.camera);
+                CascadeSet::fit_with_state_ranked(&camera, direction, splits, options, into, &rank)
+            }
+            None => CascadeSet::fit_with_state(&camera, direction, splits, options, into),
+        }
+    };
     let candidate = |splits: &CascadeSplits, k: u32| -> Option<Candidate> {
         let options = cascade_options(input, k, direction).ok()?;
         let mut scratch = held;
         let set = if stable {
             let options = options.with_fit(CascadeFit::Stable);
-            CascadeSet::fit_with_state(&camera, direction, splits, &options, &mut scratch).ok()?
+            fit_stable(splits, &options, &mut scratch).ok()?
         } else {
             CascadeSet::fit_valid(&camera, direction, splits, &options).ok()?
         };
         Some(Candidate::Cascades(set, scratch))
     };
-    let (splits, chosen) = choose_splits(plan, input, range, &mut count, &candidate, choice)?;
+    let (splits, chosen) = choose_splits(plan, input, range, &mut count, &candidate)?;
     let layers = u32::try_from(splits.count()).unwrap_or(u32::MAX);
     let set = match chosen {
         // The chosen count's candidate is the set as it is kept, and the state it
@@ -80,7 +81,11 @@ pub(crate) fn fit_cascades(
                 } else {
                     CascadeFit::Tight
                 });
-            CascadeSet::fit_with_state(&camera, direction, &splits, &fit, state)?
+            if stable {
+                fit_stable(&splits, &fit, state)?
+            } else {
+                CascadeSet::fit_valid(&camera, direction, &splits, &fit)?
+            }
         }
     };
     state.set_count(count);
@@ -126,7 +131,6 @@ pub(crate) fn fit_warped(
         },
         &mut count,
         &warped,
-        CountChoice::Predict,
     )?;
     state.set_count(count);
     // Backed off on the eye's samples as the single warps are: where the slices'
@@ -317,7 +321,6 @@ fn choose_splits(
     range: HeldDepthRange,
     kept: &mut usize,
     fit: &dyn Fn(&CascadeSplits, u32) -> Option<Candidate>,
-    choice: CountChoice,
 ) -> Result<(CascadeSplits, Option<Candidate>), FitError> {
     let max = plan.max_cascades.clamp(1, MAX_CASCADES);
     let side = |k: usize| input.layer_side(u32::try_from(k).unwrap_or(u32::MAX));
@@ -335,9 +338,6 @@ fn choose_splits(
             splits.with_ends(range.cover.0, range.cover.1)?
         })
     };
-    if choice == CountChoice::Keep && allowed(*kept) {
-        return Ok((splits_of(*kept)?, None));
-    }
     let mut candidates: ArrayVec<(usize, Candidate), MAX_CASCADES> = ArrayVec::new();
     for k in (1..=max).filter(|k| allowed(*k)) {
         let count = u32::try_from(k).unwrap_or(u32::MAX);

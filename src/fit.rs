@@ -14,9 +14,9 @@ use shadowmap_paraboloid::{ParaboloidError, ParaboloidMap};
 use shadowmap_rtw::{EyeSample, ImportanceMap, OracleAxis, RtwError, RtwShadow, WarpMaps};
 use shadowmap_warp::{WarpError, spot_warp, uniform_focused};
 
-use crate::cascaded::{CountChoice, fit_cascades, fit_warped};
+use crate::cascaded::{fit_cascades, fit_warped};
 use crate::point_fit;
-use crate::rtw_strength::{build_measured_by, warped_error};
+use crate::rtw_strength::{LitSplit, build_measured_by, warped_error};
 use crate::shadow::{Fitted, Shadow};
 use crate::technique::{DpsmOptions, RtwPlan, Technique};
 use crate::warp_fit::fit_warp;
@@ -264,17 +264,7 @@ pub(crate) fn fit_candidate(
     input: &FitInput<'_>,
     state: &mut FitState,
 ) -> Result<Shadow, FitError> {
-    fit_candidate_with(technique, input, state, CountChoice::Predict)
-}
-
-/// [`fit_candidate`], the cascades' count chosen as `count` says.
-pub(crate) fn fit_candidate_with(
-    technique: &Technique,
-    input: &FitInput<'_>,
-    state: &mut FitState,
-    count: CountChoice,
-) -> Result<Shadow, FitError> {
-    let (fitted, layers) = fit_one(technique, input, state, count)?;
+    let (fitted, layers) = fit_one(technique, input, state)?;
     let layer_side = fitted
         .own_layer_side()
         .unwrap_or_else(|| input.layer_side(layers));
@@ -292,7 +282,6 @@ fn fit_one(
     technique: &Technique,
     input: &FitInput<'_>,
     state: &mut FitState,
-    count: CountChoice,
 ) -> Result<(Fitted, u32), FitError> {
     let (camera, scene) = (input.camera, &input.scene);
     let direction = match *input.light {
@@ -309,7 +298,7 @@ fn fit_one(
         }
         Technique::StableCascades(plan) | Technique::TightCascades(plan) => {
             let stable = matches!(technique, Technique::StableCascades(_));
-            fit_cascades(plan, stable, direction, input, &mut state.cascades, count)?
+            fit_cascades(plan, stable, direction, input, &mut state.cascades)?
         }
         Technique::WarpedCascades { plan, lispsm } => {
             fit_warped(plan, lispsm, direction, input, &mut state.warped)?
@@ -497,41 +486,30 @@ fn sampled_warps(
     warps: &mut WarpMaps,
 ) -> Result<(), FitError> {
     let n = plan.importance_side;
-    let accumulated = |from: &[EyeSample]| -> Result<ImportanceMap, FitError> {
-        let mut map = ImportanceMap::new(n, n)?;
+    let accumulate = |from: &[EyeSample], map: &mut ImportanceMap| -> Result<(), FitError> {
         map.accumulate_backward(base, from, None, &plan.importance)?;
-        Ok(map)
+        Ok(())
     };
     let light = match *input.light {
         Light::Directional { direction } => LightDirection::Directional(direction),
         Light::Spot { position, .. } => LightDirection::Position(position),
         Light::Point { .. } => {
-            warps.build(&accumulated(samples)?, &plan.warp)?;
+            let mut importance = ImportanceMap::new(n, n)?;
+            accumulate(samples, &mut importance)?;
+            warps.build(&importance, &plan.warp)?;
             return Ok(());
         }
     };
     let (lit, unlit): (Vec<EyeSample>, Vec<EyeSample>) =
         samples.iter().partition(|s| is_front_lit(s, light));
-    let importance = accumulated(&lit)?;
-    // Every sample's importance: each cell holds the largest of its samples', so
-    // the front-lit samples' map raised by the others'.
-    let alternative = (!unlit.is_empty())
-        .then(|| {
-            let mut all = importance.clone();
-            all.accumulate_backward(base, &unlit, None, &plan.importance)
-                .map(|_| all)
-        })
-        .transpose()?;
-    build_measured_by(
-        &importance,
-        alternative.as_ref(),
-        &plan.warp,
-        warps,
-        |warps| {
-            let mapping = RtwShadow { base: *base, warps };
-            warped_error(&mapping, &lit, input.camera, light)
-        },
-    )
+    let split = LitSplit {
+        lit: &lit,
+        unlit: &unlit,
+    };
+    build_measured_by(n, split, accumulate, &plan.warp, warps, |warps| {
+        let mapping = RtwShadow { base: *base, warps };
+        warped_error(&mapping, &lit, input.camera, light)
+    })
 }
 
 /// The eye samples `light` reaches from the side the eye sees: normal (facing the
@@ -611,46 +589,5 @@ mod tests {
         // A light at a sample's own position lights nothing with a known normal.
         let at = LightDirection::Position(Vec3::ZERO);
         assert_eq!(front_lit(&samples, at), vec![samples[4]]);
-    }
-
-    /// `auto` fits the stable cascades with the count the tight cascades just
-    /// predicted (`CountChoice::Keep`): the same shadow as predicting it again, on
-    /// open ground (four cascades) and in a room (one).
-    #[test]
-    fn a_kept_count_fits_the_stable_cascades_as_a_predicted_one() {
-        use shadowmap_frustum::{Aabb, Projection};
-        let light = Light::Directional {
-            direction: Vec3::new(0.3, -1.0, 0.2),
-        };
-        let street = Camera::look_to(
-            Vec3::new(0.0, 2.0, 0.0),
-            Vec3::new(0.1, -0.15, -1.0),
-            Vec3::Y,
-            Projection::perspective(1.0, 16.0 / 9.0, 0.5, 300.0),
-        )
-        .unwrap();
-        let ground = Aabb::new(Vec3::new(-200.0, -1.0, -300.0), Vec3::new(200.0, 0.0, 10.0));
-        let room = Aabb::new(Vec3::new(-3.0, 0.0, -3.0), Vec3::new(3.0, 3.0, 3.0));
-        let inside = Camera::look_to(
-            Vec3::new(0.0, 1.6, 2.5),
-            Vec3::new(0.0, -0.3, -1.0),
-            Vec3::Y,
-            Projection::perspective(1.2, 16.0 / 9.0, 0.1, 100.0),
-        )
-        .unwrap();
-        let plan = crate::CascadePlan::default();
-        for (camera, scene, layers) in [(street, ground, 4), (inside, room, 1)] {
-            let input = FitInput::new(&camera, &light, SceneBounds::whole(scene), 512 * 512);
-            let fit = |count| {
-                let mut state = FitState::default();
-                let tight = Technique::TightCascades(plan);
-                fit_candidate_with(&tight, &input, &mut state, CountChoice::Predict).unwrap();
-                let stable = Technique::StableCascades(plan);
-                fit_candidate_with(&stable, &input, &mut state, count).unwrap()
-            };
-            let kept = fit(CountChoice::Keep);
-            assert_eq!(kept.layers, layers);
-            assert_eq!(kept, fit(CountChoice::Predict));
-        }
     }
 }

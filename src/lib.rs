@@ -148,6 +148,8 @@ mod cascaded;
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 mod fit;
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
+mod held_orientation;
+#[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 mod point_fit;
 #[cfg(all(feature = "warp", feature = "paraboloid", feature = "rtw"))]
 mod rtw_strength;

@@ -16,7 +16,7 @@ use shadowmap_rtw::{
 };
 
 use crate::fit::{FitError, FitInput, front_lit, is_front_lit, layer_side};
-use crate::rtw_strength::{build_measured_by, warped_error};
+use crate::rtw_strength::{LitSplit, build_measured_by, warped_error};
 use crate::sample_error::{MAX_SAMPLES, Samples, Unlit, percentile_of, sample_error};
 use crate::shadow::Fitted;
 use crate::technique::RtwPlan;
@@ -36,7 +36,7 @@ fn eye_samples<'a>(
 }
 
 /// RTW over the IPSM paraboloid: per side, importance from the eye samples that
-/// side stores ([`side_importance`]), then that side's tables at the strength of
+/// side stores ([`accumulate_side`]), then that side's tables at the strength of
 /// least error measured on the front-lit samples it stores ([`front_lit`]; with
 /// `build_measured_by`, as RTW over a directional light's uniform fit): where
 /// backward analysis misjudges a room's walls, the full warp can lose to the
@@ -125,20 +125,12 @@ fn warp_paraboloid(
     let map = ipsm.map;
     let n = plan.importance_side;
     let side_warps = |side: Side| -> Result<WarpMaps, FitError> {
-        let importance = side_importance(&map, side, lit, plan)?;
-        // Each cell holds the largest of its samples' importance: every sample's
-        // map is the lit samples' raised by the others'.
-        let alternative = (!unlit.is_empty())
-            .then(|| {
-                let mut all = importance.clone();
-                accumulate_side(&map, side, unlit, plan, &mut all).map(|()| all)
-            })
-            .transpose()?;
         let mut warps = WarpMaps::new(n, n)?;
         let light = LightDirection::Position(map.position);
         build_measured_by(
-            &importance,
-            alternative.as_ref(),
+            n,
+            LitSplit { lit, unlit },
+            |from, importance| accumulate_side(&map, side, from, plan, importance),
             &plan.warp,
             &mut warps,
             |warps| {
@@ -165,23 +157,10 @@ fn warp_paraboloid(
     })
 }
 
-/// The backward-analysis importance of `samples` over `side` of `map`, in its `uv`,
-/// scaled by the paraboloid's footprint there (world extent of a unit of `uv`
-/// across the ray: `distance / sqrt(uv² per steradian)`).
-fn side_importance(
-    map: &ParaboloidMap,
-    side: Side,
-    samples: &[EyeSample],
-    plan: &RtwPlan,
-) -> Result<ImportanceMap, FitError> {
-    let n = plan.importance_side;
-    let mut importance = ImportanceMap::new(n, n)?;
-    accumulate_side(map, side, samples, plan, &mut importance)?;
-    Ok(importance)
-}
-
-/// Raises the cells of `importance` (over `side` of `map`) to the backward-analysis
-/// importance of `samples`, as [`side_importance`] accumulates it.
+/// Raises the cells of `importance` (over `side` of `map`, in its `uv`) to the
+/// backward-analysis importance of `samples`, scaled by the paraboloid's footprint
+/// there (world extent of a unit of `uv` across the ray:
+/// `distance / sqrt(uv² per steradian)`); each cell keeps the largest.
 fn accumulate_side(
     map: &ParaboloidMap,
     side: Side,

@@ -35,10 +35,19 @@ pub(crate) fn warped_error(
     .unwrap_or(f64::INFINITY)
 }
 
-/// Builds `warps` from `importance`, or from `alternative` where one is given,
-/// raised to the strength in [`STRENGTHS`] whose warps `measure` finds the least
-/// error (the strongest on ties, `importance` on ties of both; `importance`'s full
-/// warp where nothing measures finite).
+/// The eye samples an RTW fit warps for: the front-lit ones (`n . l` at least
+/// `shadowmap_frustum::FRONT_LIT_MIN_COS`, or no normal), on which its warps are
+/// measured, and the others.
+#[derive(Clone, Copy)]
+pub(crate) struct LitSplit<'a> {
+    pub(crate) lit: &'a [EyeSample],
+    pub(crate) unlit: &'a [EyeSample],
+}
+
+/// Builds `warps` over a base from the backward importance of `samples` (a
+/// `side x side` map that `accumulate` raises by the importance of the samples it
+/// is given, each cell keeping the largest), at the strength in [`STRENGTHS`]
+/// whose warps `measure` finds the least error.
 ///
 /// Backward analysis models the texel density each sample needs (`1 / d` and an
 /// orientation term); where the model is off (a room seen along the light: a floor
@@ -54,20 +63,45 @@ pub(crate) fn warped_error(
 /// the smallest wins. So RTW is never worse than its base on the samples it was
 /// given.
 ///
-/// Which samples to accumulate is open to question, so the fits give two maps
-/// where they differ: the front-lit samples' importance (`importance`: the others
+/// Which samples to accumulate is open to question, so where some samples are not
+/// front-lit two maps are built: the front-lit samples' importance (the others
 /// are dark whatever the map holds, and a surface turned away from the light close
-/// to the eye would claim the densest rows and columns) and every sample's
-/// (`alternative`: a lit surface's neighbours turned away from the light still
-/// tell where its texels are seen). Neither wins everywhere, and the measure ranks
-/// them as the report does: over the IPSM paraboloid the front-lit samples'
-/// importance cost 1.28 times the error of every sample's in a room
+/// to the eye would claim the densest rows and columns) and every sample's (a lit
+/// surface's neighbours turned away from the light still tell where its texels
+/// are seen), the second as the first raised by the unlit samples, so the lit ones
+/// are accumulated once. Neither wins everywhere, and the measure ranks them as
+/// the report does: over the IPSM paraboloid the front-lit samples' importance
+/// cost 1.28 times the error of every sample's in a room
 /// (`compare --seed 54 --sweep 64`, random_indoor_room_035), and the other way
 /// round in another (seed 59, random_indoor_room_023).
 ///
 /// # Errors
-/// The warp builder's errors.
+/// `accumulate`'s errors and the warp builder's.
 pub(crate) fn build_measured_by(
+    side: u32,
+    samples: LitSplit<'_>,
+    accumulate: impl Fn(&[EyeSample], &mut ImportanceMap) -> Result<(), FitError>,
+    options: &WarpOptions,
+    warps: &mut WarpMaps,
+    measure: impl Fn(&WarpMaps) -> f64,
+) -> Result<(), FitError> {
+    let mut importance = ImportanceMap::new(side, side)?;
+    accumulate(samples.lit, &mut importance)?;
+    let alternative = (!samples.unlit.is_empty())
+        .then(|| {
+            let mut all = importance.clone();
+            accumulate(samples.unlit, &mut all).map(|()| all)
+        })
+        .transpose()?;
+    build_finest(&importance, alternative.as_ref(), options, warps, measure)
+}
+
+/// Builds `warps` from `importance`, or from `alternative` where one is given,
+/// raised to the strength in [`STRENGTHS`] whose warps `measure` finds the least
+/// error (the strongest on ties, `importance` on ties of both; `importance`'s full
+/// warp where nothing measures finite). Strength 0, the base alone for either
+/// map, is measured once.
+fn build_finest(
     importance: &ImportanceMap,
     alternative: Option<&ImportanceMap>,
     options: &WarpOptions,
@@ -136,7 +170,7 @@ mod tests {
         options: &WarpOptions,
         warps: &mut WarpMaps,
     ) -> Result<(), FitError> {
-        build_measured_by(importance, None, options, warps, |warps| {
+        build_finest(importance, None, options, warps, |warps| {
             warped_error(&RtwShadow { base: *base, warps }, samples, camera, light)
         })
     }

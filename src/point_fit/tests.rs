@@ -228,7 +228,8 @@ fn point_rtw_keeps_the_finer_importance_on_the_front_lit_samples() {
                 warped_error(&mapping, &lit, &case.plan.camera, light)
             };
             let full = |samples: &[EyeSample]| {
-                let importance = side_importance(map, side, samples, &rtw).unwrap();
+                let mut importance = ImportanceMap::new(32, 32).unwrap();
+                accumulate_side(map, side, samples, &rtw, &mut importance).unwrap();
                 let mut warps = WarpMaps::new(32, 32).unwrap();
                 warps.build(&importance, &rtw.warp).unwrap();
                 error(&warps)

@@ -135,6 +135,18 @@ pub struct Cascade {
     pub receivers_missed: bool,
 }
 
+/// A caller's rank of a stable cascade's candidate orientations: given the
+/// candidate cascades over one slice (the view's frame first), the index of the
+/// one to keep (see [`CascadeSet::fit_with_state_ranked`]).
+pub type OrientationRank<'a> = &'a dyn Fn(&[Cascade]) -> usize;
+
+/// What the stable fit holds across frames, and the caller's rank of new
+/// orientations (see [`CascadeSet::fit_with_state_ranked`]).
+struct Held<'a> {
+    state: &'a mut CascadeState,
+    rank: Option<OrientationRank<'a>>,
+}
+
 /// A fitted set of cascades for a directional light.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -243,8 +255,53 @@ impl CascadeSet {
         options: &CascadeOptions,
         state: &mut CascadeState,
     ) -> Result<Self, FrustumError> {
+        Self::fit_held(camera, light_direction, splits, options, state, None)
+    }
+
+    /// As [`CascadeSet::fit_with_state`], with the caller ranking a stable
+    /// cascade's orientations where a new one is chosen: `rank` is given the
+    /// cascade over the slice in this frame's orientation (first, the one
+    /// [`CascadeSet::fit_with_state`] keeps) and in up to
+    /// [`MAX_HELD_CANDIDATES`](crate::MAX_HELD_CANDIDATES)` - 1` others that box the slice ∩ receivers in less
+    /// area, each with a side along an edge of its outline across the light
+    /// (the least-area rectangle around a convex polygon has one: Freeman and
+    /// Shapira, 1975), and returns the index of the one to keep.
+    ///
+    /// A frame that follows the view boxes a footprint cut by a room's walls at
+    /// whatever angle the view makes with them; a frame along the walls can hold
+    /// the same footprint, turn allowance included, in half the area. Less area
+    /// is not always finer where the eye looks (the texels' shape and orientation
+    /// against the view count too), so the choice is the caller's: a renderer with
+    /// the frame's visible samples (a depth and normal buffer) measures each
+    /// candidate's error on them, as `shadowmap::fit` does.
+    ///
+    /// # Errors
+    /// As [`CascadeSet::fit_with_state`].
+    pub fn fit_with_state_ranked(
+        camera: &ValidCamera,
+        light_direction: Vec3,
+        splits: &CascadeSplits,
+        options: &CascadeOptions,
+        state: &mut CascadeState,
+        rank: OrientationRank<'_>,
+    ) -> Result<Self, FrustumError> {
+        Self::fit_held(camera, light_direction, splits, options, state, Some(rank))
+    }
+
+    fn fit_held(
+        camera: &ValidCamera,
+        light_direction: Vec3,
+        splits: &CascadeSplits,
+        options: &CascadeOptions,
+        state: &mut CascadeState,
+        rank: Option<OrientationRank<'_>>,
+    ) -> Result<Self, FrustumError> {
         let mut next = *state;
-        let set = Self::fit_inner(camera, light_direction, splits, options, Some(&mut next))?;
+        let held = Some(Held {
+            state: &mut next,
+            rank,
+        });
+        let set = Self::fit_inner(camera, light_direction, splits, options, held)?;
         *state = next;
         Ok(set)
     }
@@ -257,7 +314,7 @@ impl CascadeSet {
         light_direction: Vec3,
         splits: &CascadeSplits,
         options: &CascadeOptions,
-        state: Option<&mut CascadeState>,
+        held: Option<Held<'_>>,
     ) -> Result<Self, FrustumError> {
         // The result is made first and filled in place: the set is large.
         let mut out = Ok(Self {
@@ -267,7 +324,7 @@ impl CascadeSet {
             resolution: options.resolution,
         });
         if let Ok(set) = &mut out
-            && let Err(e) = set.fill(camera, light_direction, options, state)
+            && let Err(e) = set.fill(camera, light_direction, options, held)
         {
             out = Err(e);
         }
@@ -280,10 +337,17 @@ impl CascadeSet {
         camera: &ValidCamera,
         light_direction: Vec3,
         options: &CascadeOptions,
-        mut state: Option<&mut CascadeState>,
+        held: Option<Held<'_>>,
     ) -> Result<(), FrustumError> {
         let checked = Fitter::check(light_direction, options)?;
-        let fitter = Fitter::new(&camera.geometry, checked, options);
+        let mut fitter = Fitter::new(&camera.geometry, checked, options);
+        let mut state = None;
+        if let Some(held) = held {
+            state = Some(held.state);
+            if let Some(rank) = held.rank {
+                fitter.rank_with(rank);
+            }
+        }
         let (splits, set) = (&self.splits, &mut self.cascades);
         // Cascades of an earlier fit (a refit) are overwritten where they are: every
         // fit writes every field.

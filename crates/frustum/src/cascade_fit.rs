@@ -9,8 +9,8 @@ use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
 use crate::body::ConvexBody;
 use crate::bounding_sphere::{bounding_sphere, symmetric_slice_sphere};
 use crate::camera::CameraGeometry;
-use crate::cascade::{Cascade, CascadeFit, CascadeOptions};
-use crate::cascade_state::{HeldSlot, held_box};
+use crate::cascade::{Cascade, CascadeFit, CascadeOptions, OrientationRank};
+use crate::cascade_state::{ChooseBox, HeldBox, HeldSlot, MAX_HELD_CANDIDATES, held_box};
 use crate::light::unit;
 use crate::light_prism::LightPrism;
 use crate::mapping::{LightDirection, ShadowTransform};
@@ -41,6 +41,9 @@ pub fn fit_cascade(
 /// per call of [`CascadeSet::fit`](crate::CascadeSet::fit).
 pub(crate) struct Fitter<'a> {
     camera: &'a CameraGeometry,
+    /// The caller's rank of a stable cascade's candidate orientations (see
+    /// [`CascadeSet::fit_with_state_ranked`](crate::CascadeSet::fit_with_state_ranked)).
+    rank: Option<OrientationRank<'a>>,
     light_dir: DVec3,
     light_from_world: DMat4,
     /// `light_from_world` in `f32`, as stored in every cascade.
@@ -94,6 +97,7 @@ impl<'a> Fitter<'a> {
         let view = &camera.world_from_view;
         Self {
             camera,
+            rank: None,
             light_dir,
             light_from_world,
             light_from_world32: light_from_world.as_mat4(),
@@ -111,6 +115,11 @@ impl<'a> Fitter<'a> {
             options: *options,
             scene,
         }
+    }
+
+    /// Gives the stable fit the caller's rank of candidate orientations.
+    pub(crate) fn rank_with(&mut self, rank: OrientationRank<'a>) {
+        self.rank = Some(rank);
     }
 
     /// The view depths `[near, far]` checked against the camera's range, in `f64`.
@@ -324,8 +333,12 @@ impl<'a> Fitter<'a> {
         Ok(body)
     }
 
-    /// The stable fit with a caller-held map ([`held_box`]): a square over
-    /// slice ∩ receivers whose side and orientation are kept across frames.
+    /// The stable fit with a caller-held map ([`held_box`]): a box over
+    /// slice ∩ receivers whose extents and orientation are kept across frames.
+    /// Where a new orientation is chosen and frames along the footprint's edges box
+    /// it in less area than this frame's, the caller's rank (see
+    /// [`CascadeSet::fit_with_state_ranked`](crate::CascadeSet::fit_with_state_ranked))
+    /// chooses among them; without one, this frame's.
     fn fit_held(
         &self,
         n: f64,
@@ -335,6 +348,7 @@ impl<'a> Fitter<'a> {
     ) -> Result<Cascade, FrustumError> {
         let body = self.receivers_body(n, f, scene)?;
         let points = body.iter().map(|v| v.as_dvec3());
+        let choose = |boxes: &[HeldBox]| self.ranked(n, f, &points, boxes, scene);
         let b = held_box(
             &points,
             &scene.receivers,
@@ -342,9 +356,47 @@ impl<'a> Fitter<'a> {
             &self.light_from_world,
             f64::from(self.options.resolution),
             held,
+            self.rank.map(|_| &choose as ChooseBox<'_>),
         )?;
+        self.held_cascade(n, f, &points, &b, scene)
+    }
+
+    /// The index in `boxes` (this frame's orientation first) the caller's rank
+    /// chooses among their cascades over slice `[n, f]`; the first without a rank
+    /// or where a cascade fails.
+    fn ranked(
+        &self,
+        n: f64,
+        f: f64,
+        points: &(impl Iterator<Item = DVec3> + Clone),
+        boxes: &[HeldBox],
+        scene: &SceneBounds,
+    ) -> usize {
+        let Some(rank) = self.rank else {
+            return 0;
+        };
+        let mut cascades: ArrayVec<Cascade, MAX_HELD_CANDIDATES> = ArrayVec::new();
+        for b in boxes.iter().take(MAX_HELD_CANDIDATES) {
+            match self.held_cascade(n, f, points, b, scene) {
+                Ok(c) => cascades.push(c),
+                Err(_) => return 0,
+            }
+        }
+        rank(&cascades).min(cascades.len() - 1)
+    }
+
+    /// The cascade of slice `[n, f]` over `points` (slice ∩ receivers) in the
+    /// stable box `b`.
+    fn held_cascade(
+        &self,
+        n: f64,
+        f: f64,
+        points: &(impl Iterator<Item = DVec3> + Clone),
+        b: &HeldBox,
+        scene: &SceneBounds,
+    ) -> Result<Cascade, FrustumError> {
         let (mut z_lo, mut z_hi, mut reach) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
-        for p in points {
+        for p in points.clone() {
             reach = reach.max(p.abs().max_element());
             let z = b.light_from_world.transform_point3(p).z;
             z_lo = z_lo.min(z);

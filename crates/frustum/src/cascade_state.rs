@@ -1,8 +1,11 @@
 //! Caller-held state of the stable cascade fit: each cascade's map size and
 //! orientation, kept across frames with hysteresis.
 
+use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec3, Vec3};
 
+use crate::min_area::{MAX_HULL, edge_ups, hull_across};
+use crate::projection::light_rotation;
 use crate::{Aabb, FrustumError, MAX_CASCADES, math};
 
 /// Largest turn of the camera about the world's up axis (`+Y`, radians) that a
@@ -101,7 +104,10 @@ struct HeldMap {
 /// fit of Zhang et al.'s parallel-split shadow maps, made rotation invariant), the
 /// held box spends its texels on the visible receivers, and its orientation is the
 /// one that fits them when it is chosen rather than one fixed in the world (a
-/// footprint at 45° to a world-fixed frame needs a box up to 1.41 times larger).
+/// footprint at 45° to a world-fixed frame needs a box up to 1.41 times larger):
+/// the view's, or one along an edge of the footprint that boxes it in less area,
+/// where the caller ranks those
+/// ([`CascadeSet::fit_with_state_ranked`](crate::CascadeSet::fit_with_state_ranked)).
 ///
 /// The held sizes stay only while the slices stay: split a depth range held by
 /// [`CascadeState::hold_depth_range`] (and extend the end cascades with
@@ -345,7 +351,11 @@ fn with_slack(extent: DVec2, scale: f64, res: f64) -> Result<DVec2, FrustumError
     }
 }
 
+/// Chooses among candidate boxes (this frame's orientation first) by index.
+pub(crate) type ChooseBox<'a> = &'a dyn Fn(&[HeldBox]) -> usize;
+
 /// A stable cascade's box, chosen by [`held_box`].
+#[derive(Clone, Copy)]
 pub(crate) struct HeldBox {
     /// The light frame (rotation) the box lies in.
     pub(crate) light_from_world: DMat4,
@@ -373,9 +383,102 @@ pub(crate) fn held_box(
     frame: &DMat4,
     res: f64,
     held: &mut HeldSlot<'_>,
+    choose: Option<ChooseBox<'_>>,
 ) -> Result<HeldBox, FrustumError> {
-    let phi = STABLE_TURN * direction.y.abs();
-    let fit = |light: DMat4, held: DVec2| -> Result<(HeldBox, DVec2, bool), FrustumError> {
+    let fit = Fit {
+        receivers,
+        res,
+        phi: STABLE_TURN * direction.y.abs(),
+    };
+    if let Some(up) = held.up_for(direction) {
+        let light = light_rotation(direction, up);
+        let (b, _, kept) = fit.boxed(points, light, held.0.side)?;
+        if kept {
+            return Ok(b);
+        }
+    }
+    // This frame's orientation, by its y axis (the rotation's second row), stored in
+    // f32 and the frame rebuilt from it, so that the frames that keep it rebuild
+    // exactly the same rotation.
+    let own = DVec3::new(frame.x_axis.y, frame.y_axis.y, frame.z_axis.y).as_vec3();
+    let mut boxes: ArrayVec<(HeldBox, DVec2, Vec3), MAX_HELD_CANDIDATES> = ArrayVec::new();
+    let (b, side, _) = fit.boxed(points, light_rotation(direction, own), DVec2::ZERO)?;
+    boxes.push((b, side, own));
+    // Rivals only for a caller that ranks them.
+    if choose.is_some() {
+        for up in rivals(points, direction, own, side, &fit)? {
+            let (b, side, _) = fit.boxed(points, light_rotation(direction, up), DVec2::ZERO)?;
+            boxes.push((b, side, up));
+        }
+    }
+    let chosen = match choose {
+        Some(choose) if boxes.len() > 1 => {
+            let candidates: ArrayVec<HeldBox, MAX_HELD_CANDIDATES> =
+                boxes.iter().map(|b| b.0).collect();
+            choose(&candidates).min(boxes.len() - 1)
+        }
+        _ => 0,
+    };
+    let (b, side, up) = boxes[chosen];
+    *held.0 = HeldMap { side, up };
+    Ok(b)
+}
+
+/// Most orientations besides the frame's own that a new stable box is chosen among.
+const RIVALS: usize = 3;
+
+/// Most candidate cascades a rank of a stable cascade's orientations is given
+/// (see [`CascadeSet::fit_with_state_ranked`](crate::CascadeSet::fit_with_state_ranked)):
+/// this frame's orientation and its rivals.
+pub const MAX_HELD_CANDIDATES: usize = 1 + RIVALS;
+
+/// The orientations along edges of the footprint's hull across the light
+/// ([`min_area`](crate::min_area)) that box it, turn allowance included, in less
+/// area than `own` (whose box has extents `own_side`): the [`RIVALS`] of least
+/// area, one per area (a rectangle's edges give each box twice, a quarter turn
+/// apart, the same texels).
+fn rivals(
+    points: &(impl Iterator<Item = DVec3> + Clone),
+    direction: DVec3,
+    own: Vec3,
+    own_side: DVec2,
+    fit: &Fit<'_>,
+) -> Result<ArrayVec<Vec3, RIVALS>, FrustumError> {
+    let own_frame = light_rotation(direction, own);
+    let hull = hull_across(points.clone(), &own_frame);
+    let corners = hull.iter().map(|(_, p)| *p);
+    let own_area = own_side.x * own_side.y;
+    let mut smaller: ArrayVec<(f64, Vec3), MAX_HULL> = ArrayVec::new();
+    for up in edge_ups(&hull, &own_frame) {
+        let (_, side, _) = fit.boxed(&corners, light_rotation(direction, up), DVec2::ZERO)?;
+        let area = side.x * side.y;
+        let new = smaller.iter().all(|(a, _)| (area - a).abs() > 1e-9 * area);
+        if area < own_area * (1.0 - 1e-6) && new {
+            smaller.push((area, up));
+        }
+    }
+    smaller.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(smaller.iter().take(RIVALS).map(|(_, up)| *up).collect())
+}
+
+/// What a stable box is fitted against: the receivers' box, the resolution and
+/// the turn allowance's angle about the light.
+struct Fit<'a> {
+    receivers: &'a Aabb,
+    res: f64,
+    phi: f64,
+}
+
+impl Fit<'_> {
+    /// The box over `points` in the frame `light` with the extents [`hold_side`]
+    /// keeps or chooses from `held` (zero: none), its extents and whether `held`
+    /// was kept; the centre snapped to whole texels.
+    fn boxed(
+        &self,
+        points: &(impl Iterator<Item = DVec3> + Clone),
+        light: DMat4,
+        held: DVec2,
+    ) -> Result<(HeldBox, DVec2, bool), FrustumError> {
         let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
         for p in points.clone() {
             let q = light.transform_point3(p).truncate();
@@ -383,13 +486,14 @@ pub(crate) fn held_box(
             hi = hi.max(q);
         }
         let scale = lo.abs().max(hi.abs()).max_element();
-        let needed = with_slack(hi - lo, scale, res)?;
+        let needed = with_slack(hi - lo, scale, self.res)?;
         let turned = || {
-            let turned = turned_extent(points, &light, phi).min(box_extent(receivers, &light));
-            with_slack(turned, scale, res)
+            let turned =
+                turned_extent(points, &light, self.phi).min(box_extent(self.receivers, &light));
+            with_slack(turned, scale, self.res)
         };
         let (side, kept) = hold_side(held, needed, turned)?;
-        let texel = side / res;
+        let texel = side / self.res;
         let center = ((lo + hi) * 0.5 / texel).round() * texel;
         let b = HeldBox {
             light_from_world: light,
@@ -398,26 +502,7 @@ pub(crate) fn held_box(
             texel: texel.max_element(),
         };
         Ok((b, side, kept))
-    };
-    if let Some(up) = held.up_for(direction) {
-        let (b, _, kept) = fit(
-            crate::projection::light_rotation(direction, up),
-            held.0.side,
-        )?;
-        if kept {
-            return Ok(b);
-        }
     }
-    // This frame's orientation, by its y axis (the rotation's second row), stored in
-    // f32 and the frame rebuilt from it, so that the frames that keep it rebuild
-    // exactly the same rotation.
-    let up = DVec3::new(frame.x_axis.y, frame.y_axis.y, frame.z_axis.y).as_vec3();
-    let (b, side, _) = fit(
-        crate::projection::light_rotation(direction, up),
-        DVec2::ZERO,
-    )?;
-    *held.0 = HeldMap { side, up };
-    Ok(b)
 }
 
 #[cfg(test)]
@@ -577,6 +662,7 @@ mod tests {
             &frame,
             res,
             &mut slot,
+            None,
         )
         .unwrap();
         let (turned, cap) = (
@@ -610,7 +696,7 @@ mod tests {
         let mut fit = |points: &[DVec3], frame: &DMat4| {
             let mut slot = state.slot(0).unwrap();
             let points = points.iter().copied();
-            held_box(&points, &receivers, direction, frame, res, &mut slot).unwrap()
+            held_box(&points, &receivers, direction, frame, res, &mut slot, None).unwrap()
         };
         let a = fit(&footprint, &frame);
         let covers = |b: &HeldBox, shift: DVec3| {
