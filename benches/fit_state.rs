@@ -1,8 +1,9 @@
 //! Per-frame cost of the umbrella's stateful fits of a directional light
 //! (`shadowmap::fit_with_state`): LiSPSM with and without the eye samples (which it
 //! measures its strength on), the stable, tight and warped cascades with their
-//! count chosen from the predicted error (the tight and stable ones also given the
-//! eye samples of a 160 x 90 G-buffer, which they measure each count on), and
+//! count chosen from the predicted error (also given the eye samples of a 160 x 90
+//! G-buffer, which they measure each count on, the warped ones at the strength
+//! each count measures finest at), and
 //! `auto`, which fits all seven candidates and predicts their error (or, given the
 //! samples, measures it on them), and the stable cascades from a fresh state (every
 //! map sized, its orientation ranked on the samples where given); each beside the
@@ -125,6 +126,7 @@ fn fits(c: &mut Criterion) {
             Technique::StableCascades(plan),
             &sampled,
         ),
+        ("warped_on_samples", warped, &sampled),
         ("auto_on_samples", Technique::Auto(plan), &sampled),
     ];
     if only(&techniques) {

@@ -40,7 +40,7 @@ pub fn auto_candidates(plan: &CascadePlan) -> [Technique; AUTO_CANDIDATE_COUNT] 
 /// more samples than that is measured whole at once). With the cascades' counts,
 /// the stable maps' orientations and the warps' strengths measured on the same
 /// samples, `auto` on a 160 x 90 G-buffer's samples takes about 1.26 ms a frame in
-/// all (`cargo bench --bench fit_state`: `auto_on_samples`, about 680 times the
+/// all (`cargo bench --bench fit_state`: `auto_on_samples`, about 660 times the
 /// uniform fit). The warps at their predicted strength only took 0.8 ms against
 /// 1.4 ms when that was measured, and measured 1.2 times the best technique over
 /// a fence at seed 14.

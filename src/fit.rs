@@ -224,8 +224,8 @@ pub fn fit_with_selector(
 pub struct FitState {
     /// `auto`'s current choice, kept with hysteresis.
     pub selector: TechniqueSelector,
-    /// The stable cascades' maps (and the stable and tight cascades' count), kept
-    /// with hysteresis.
+    /// The stable cascades' maps, of every count the count prediction fits (and
+    /// the stable and tight cascades' count), kept with hysteresis.
     pub cascades: CascadeState,
     /// The warped cascades' count, kept with hysteresis (their maps are not held).
     pub warped: CascadeState,

@@ -359,7 +359,7 @@ impl CascadeSet {
             let (near, far) = splits
                 .cascade_range(i)
                 .ok_or(FrustumError::InvalidCascadeCount)?;
-            let held = state.as_deref_mut().and_then(|s| s.slot(i));
+            let held = state.as_deref_mut().and_then(|s| s.slot(splits.count(), i));
             keep(set, i, fitter.fit_or_whole(near, far, held)?)?;
         }
         Ok(())

@@ -3,6 +3,8 @@
 //! then each slice's light-space box (tight, stable sphere, stable ladder, or held
 //! across frames), its depth range pulled back to the casters, and its matrices.
 
+use core::cell::Cell;
+
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
 
@@ -348,7 +350,13 @@ impl<'a> Fitter<'a> {
     ) -> Result<Cascade, FrustumError> {
         let body = self.receivers_body(n, f, scene)?;
         let points = body.iter().map(|v| v.as_dvec3());
-        let choose = |boxes: &[HeldBox]| self.ranked(n, f, &points, boxes, scene);
+        // The rank builds every candidate's cascade; the one it chooses is kept.
+        let ranked_cascade = Cell::new(None);
+        let choose = |boxes: &[HeldBox]| {
+            let (index, cascade) = self.ranked(n, f, &points, boxes, scene);
+            ranked_cascade.set(cascade);
+            index
+        };
         let b = held_box(
             &points,
             &scene.receivers,
@@ -358,12 +366,15 @@ impl<'a> Fitter<'a> {
             held,
             self.rank.map(|_| &choose as ChooseBox<'_>),
         )?;
-        self.held_cascade(n, f, &points, &b, scene)
+        match ranked_cascade.take() {
+            Some(cascade) => Ok(cascade),
+            None => self.held_cascade(n, f, &points, &b, scene),
+        }
     }
 
     /// The index in `boxes` (this frame's orientation first) the caller's rank
-    /// chooses among their cascades over slice `[n, f]`; the first without a rank
-    /// or where a cascade fails.
+    /// chooses among their cascades over slice `[n, f]`, and the chosen cascade;
+    /// the first index (and no cascade) without a rank or where a cascade fails.
     fn ranked(
         &self,
         n: f64,
@@ -371,18 +382,20 @@ impl<'a> Fitter<'a> {
         points: &(impl Iterator<Item = DVec3> + Clone),
         boxes: &[HeldBox],
         scene: &SceneBounds,
-    ) -> usize {
+    ) -> (usize, Option<Cascade>) {
         let Some(rank) = self.rank else {
-            return 0;
+            return (0, None);
         };
         let mut cascades: ArrayVec<Cascade, MAX_HELD_CANDIDATES> = ArrayVec::new();
         for b in boxes.iter().take(MAX_HELD_CANDIDATES) {
             match self.held_cascade(n, f, points, b, scene) {
                 Ok(c) => cascades.push(c),
-                Err(_) => return 0,
+                Err(_) => return (0, None),
             }
         }
-        rank(&cascades).min(cascades.len() - 1)
+        // An index past the candidates: `held_box` keeps the last, fitted again.
+        let index = rank(&cascades);
+        (index, cascades.get(index).copied())
     }
 
     /// The cascade of slice `[n, f]` over `points` (slice ∩ receivers) in the

@@ -90,6 +90,13 @@ struct HeldMap {
 /// map extents in light-space units and the up vector that orients its light frame,
 /// and the cascade count the caller chose.
 ///
+/// The maps are held per cascade count (the fit of `n` cascades reads and writes
+/// the `n`-cascade maps only), so that a caller that fits several counts each
+/// frame to choose among them keeps every count's maps: a count not chosen this
+/// frame is measured next frame with the maps it would be drawn with, and its new
+/// maps are sized (and, where ranked, their orientations chosen) once rather than
+/// every frame.
+///
 /// The stable fit ([`CascadeSet::fit_with_state`](crate::CascadeSet::fit_with_state))
 /// fits each cascade's box to its slice ∩ receivers, as the tight fit does, but keeps
 /// the box's extents and orientation from the previous frame while they still cover
@@ -119,8 +126,8 @@ struct HeldMap {
 /// simply re-sizes the cascades that no longer fit.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CascadeState {
-    /// Held map per cascade.
-    held: [HeldMap; MAX_CASCADES],
+    /// Held map per cascade of each cascade count (`held[count - 1][index]`).
+    held: [[HeldMap; MAX_CASCADES]; MAX_CASCADES],
     /// Cascade count of the previous frame (0: none), for callers that keep the
     /// count with hysteresis.
     count: usize,
@@ -134,10 +141,10 @@ impl CascadeState {
     #[must_use]
     pub const fn new() -> Self {
         Self {
-            held: [HeldMap {
+            held: [[HeldMap {
                 side: DVec2::ZERO,
                 up: Vec3::ZERO,
-            }; MAX_CASCADES],
+            }; MAX_CASCADES]; MAX_CASCADES],
             count: 0,
             depth_range: HeldDepthRange {
                 split: (0.0, 0.0),
@@ -225,18 +232,23 @@ impl CascadeState {
         *self = Self::new();
     }
 
-    /// The held map extents of cascade `index` (light-space x and y), `None` when
-    /// unset.
+    /// The held map extents of cascade `index` of a set of `count` cascades
+    /// (light-space x and y), `None` when unset.
     #[must_use]
-    pub fn size(&self, index: usize) -> Option<DVec2> {
+    pub fn size(&self, count: usize, index: usize) -> Option<DVec2> {
         self.held
+            .get(count.checked_sub(1)?)?
             .get(index)
             .map(|h| h.side)
             .filter(|s| s.min_element() > 0.0)
     }
 
-    pub(crate) fn slot(&mut self, index: usize) -> Option<HeldSlot<'_>> {
-        self.held.get_mut(index).map(HeldSlot)
+    /// The held map of cascade `index` of a set of `count` cascades.
+    pub(crate) fn slot(&mut self, count: usize, index: usize) -> Option<HeldSlot<'_>> {
+        self.held
+            .get_mut(count.checked_sub(1)?)?
+            .get_mut(index)
+            .map(HeldSlot)
     }
 }
 
@@ -654,7 +666,7 @@ mod tests {
             )
         });
         let mut state = CascadeState::new();
-        let mut slot = state.slot(0).unwrap();
+        let mut slot = state.slot(1, 0).unwrap();
         let b = held_box(
             &corners.iter().copied(),
             &floor,
@@ -694,7 +706,7 @@ mod tests {
         let mut state = CascadeState::new();
         let receivers = Aabb::new(Vec3::splat(-200.0), Vec3::splat(200.0));
         let mut fit = |points: &[DVec3], frame: &DMat4| {
-            let mut slot = state.slot(0).unwrap();
+            let mut slot = state.slot(1, 0).unwrap();
             let points = points.iter().copied();
             held_box(&points, &receivers, direction, frame, res, &mut slot, None).unwrap()
         };
@@ -725,6 +737,8 @@ mod tests {
         let c = fit(&big, &other);
         assert!((c.light_from_world.y_axis - other.y_axis).length() < 1e-6);
         assert!(c.texel > 2.0 * a.texel);
-        assert!(state.size(0).is_some() && state.size(1).is_none());
+        assert!(
+            state.size(1, 0).is_some() && state.size(1, 1).is_none() && state.size(2, 0).is_none()
+        );
     }
 }

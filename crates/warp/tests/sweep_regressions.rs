@@ -39,7 +39,7 @@ const ROOM: Aabb = Aabb {
     max: Vec3::new(5.0, 3.0, 4.0),
 };
 
-const CASES: [Case; 5] = [
+const CASES: [Case; 6] = [
     Case {
         what: "camera 33 m up in a 2 km scene, light 14 degrees off the view (XPSM 61x, LiSPSM 11x)",
         eye: Vec3::new(7.1513143, 32.667534, 934.70056),
@@ -83,6 +83,15 @@ const CASES: [Case; 5] = [
         near: 0.11838343,
         far: 15.783536,
         light: Vec3::new(-0.11083921, -0.99353665, 0.024487047),
+        scene: ROOM,
+    },
+    Case {
+        what: "inside a room facing a wall lit from behind the camera, the floor lit at 3.4 degrees (XPSM 1.61x, LiSPSM 1.55x)",
+        eye: Vec3::new(-2.4356012, 1.538165, 1.5955052),
+        forward: Vec3::new(0.49721867, 0.076921076, 0.86420876),
+        near: 0.18294066,
+        far: 15.783536,
+        light: Vec3::new(0.5886504, -0.057770487, 0.80632085),
         scene: ROOM,
     },
 ];
