@@ -340,11 +340,10 @@ fn cube_input(case: &CubeSamplesCase, budget: u64) -> FitInput<'_> {
 }
 
 /// Cube maps sized by the samples' needs with the orientation left to the fit keep
-/// the orientation whose samples' error is the smaller; both are kept in some
-/// cases.
+/// the orientation whose samples' error is the least; each is kept in some cases.
 #[test]
 fn cube_keeps_the_finer_orientation_on_the_samples() {
-    let (mut world, mut turned) = (0, 0);
+    let mut kept = [0; 3];
     for case in cube_cases(0x7c3e_9a51_d28f_4b61, 300) {
         let input = cube_input(&case, 1 << 16);
         let options = case.cube.options.with_sizes(FaceSizes::ByNeed);
@@ -355,21 +354,74 @@ fn cube_keeps_the_finer_orientation_on_the_samples() {
                 .unwrap_or(f64::INFINITY)
         };
         let fitted = |o| fit_cube(&options.with_orientation(o), &input);
-        let (Ok(chosen), Ok(a), Ok(b)) = (
+        let (Ok(chosen), Ok(a), Ok(b), Ok(c)) = (
             fitted(CubeOrientation::Predicted),
             fitted(CubeOrientation::WorldAxes),
             fitted(CubeOrientation::TowardReceivers),
+            fitted(CubeOrientation::CornerUp),
         ) else {
             continue;
         };
-        let (e, a, b) = (error(&chosen), error(&a), error(&b));
-        assert!(e <= a.min(b), "{e} kept, {a} and {b} on offer");
-        world += usize::from(e == a && a < b);
-        turned += usize::from(e == b && b < a);
+        let (e, offered) = (error(&chosen), [error(&a), error(&b), error(&c)]);
+        let least = offered.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!(e <= least, "{e} kept, {offered:?} on offer");
+        if let Some(i) = offered.iter().position(|x| *x == e) {
+            kept[i] += usize::from(offered.iter().filter(|x| **x == e).count() == 1);
+        }
     }
     assert!(
-        world >= 10 && turned >= 10,
-        "world {world}, turned {turned}"
+        kept.iter().all(|k| *k >= 10),
+        "kept (world, turned, corner up) {kept:?}"
+    );
+}
+
+/// A lamp 6.6 m up in a street 60 m wide between 12 m walls, seen from 11 m up
+/// and 30 m away: the walls and the far street the eye sees lie around the lamp
+/// near its horizon, which a level cube's side faces cut through their centres.
+/// The cube sized on the samples stands on a corner, finer on them than either
+/// level orientation (over a city block lit from 6.6 m at seed 114 of `compare
+/// --sweep 64`, random_city_block_038, the level cube measured 1.16 times DPSM,
+/// stood on a corner 0.91 times).
+#[test]
+fn a_lamp_in_a_street_stands_its_cube_on_a_corner() {
+    use shadowmap_frustum::{Aabb, Camera, Light, Projection};
+    let lamp = Vec3::new(0.0, 6.6, 0.0);
+    let eye = Vec3::new(-20.0, 11.0, 20.0);
+    let street = Aabb::new(Vec3::new(-100.0, 0.0, -30.0), Vec3::new(100.0, 12.0, 30.0));
+    let camera = Camera::look_to(
+        eye,
+        lamp - eye,
+        Vec3::Y,
+        Projection::perspective(1.0, 16.0 / 9.0, 0.5, 1000.0),
+    )
+    .unwrap();
+    let samples = crate::test_views::room_samples(&camera, &street, 160, 90);
+    let light = Light::Point {
+        position: lamp,
+        range: 600.0,
+    };
+    let input = FitInput::new(&camera, &light, SceneBounds::whole(street), 16_200)
+        .with_eye_samples(&samples)
+        .with_depth_bounds(crate::depth_bounds_of(&camera, &samples))
+        .with_pixels_per_radian(90.0);
+    let options = CubeOptions::default().with_sizes(FaceSizes::ByNeed);
+    let fitted = |o| fit_cube(&options.with_orientation(o), &input).unwrap();
+    let error = |mut cube: CubeMap| {
+        size_by_samples(&mut cube, &input, &samples, 90.0)
+            .unwrap()
+            .unwrap()
+    };
+    let corner = fitted(CubeOrientation::CornerUp);
+    assert_eq!(
+        fitted(CubeOrientation::Predicted).orientation(),
+        corner.orientation()
+    );
+    let level = error(fitted(CubeOrientation::WorldAxes))
+        .min(error(fitted(CubeOrientation::TowardReceivers)));
+    let stood = error(corner);
+    assert!(
+        stood < 0.85 * level,
+        "{stood} stood on a corner, {level} level"
     );
 }
 

@@ -180,6 +180,18 @@ pub enum CubeOrientation {
     /// lies straight above or below the light. The turn follows the centre
     /// continuously (a quarter turn maps the cube onto itself).
     TowardReceivers,
+    /// Stood on a corner: the cube's diagonal along the world's `Y` axis, turned
+    /// about it so that the lower face nearest the visible receivers' centre, seen
+    /// from the light, faces it across the level (by at most 60 degrees; a third of
+    /// a turn maps the cube onto itself). A light among receivers spread around it
+    /// near its own height (a lamp over a street or a clearing) sees most of them
+    /// near its horizon, which a level cube's side faces cut through their
+    /// centres, where a face's texel covers the most solid angle (a fifth of what
+    /// it covers at the face's corners); stood on a corner, the horizon crosses
+    /// every face away from its centre (at most 0.54 times the solid angle of a
+    /// level face's centre texel). The level frame's turn when the centre lies
+    /// straight above or below the light.
+    CornerUp,
     /// Of [`WorldAxes`](Self::WorldAxes) and
     /// [`TowardReceivers`](Self::TowardReceivers), the one with the smaller predicted
     /// error at the budget: the largest over the kept faces of the 95th percentile of
@@ -188,11 +200,39 @@ pub enum CubeOrientation {
     /// twice and predicts twice: about 34 times the cost of either orientation alone
     /// with equal faces (322 us against 9.5 us, `cargo bench --bench paraboloid --
     /// cube_fit`), so not the default; `shadowmap::fit` measures both orientations
-    /// on the eye's samples instead when it has them.
+    /// and [`CornerUp`](Self::CornerUp) on the eye's samples instead when it has
+    /// them.
     Predicted,
 }
 
 impl CubeOrientation {
+    /// The turn of [`CornerUp`](Self::CornerUp) (world from cube) for the visible
+    /// receivers' vertices given relative to the light, rounded to `f32` as the map
+    /// stores it.
+    fn turn_corner_up(relative: &[DVec3]) -> Quat {
+        let stand = DQuat::from_rotation_arc(DVec3::ONE.normalize(), DVec3::Y);
+        let level = |v: DVec3| DVec3::new(v.x, 0.0, v.z).normalize_or_zero();
+        let centre = relative.iter().fold(DVec3::ZERO, |a, v| a + *v);
+        let toward = level(centre);
+        // The lower faces' normals, a third of a turn apart about the diagonal.
+        let lower = [DVec3::NEG_X, DVec3::NEG_Y, DVec3::NEG_Z].map(|n| level(stand * n));
+        let nearest = lower
+            .into_iter()
+            .max_by(|a, b| a.dot(toward).total_cmp(&b.dot(toward)))
+            .unwrap_or(DVec3::X);
+        let turn = if toward == DVec3::ZERO {
+            stand
+        } else {
+            DQuat::from_rotation_arc(nearest, toward) * stand
+        };
+        let turn = turn.as_quat().normalize();
+        if turn.is_finite() {
+            turn
+        } else {
+            Quat::IDENTITY
+        }
+    }
+
     /// The turn of [`TowardReceivers`](Self::TowardReceivers) (world from cube) for
     /// the visible receivers' vertices given relative to the light, rounded to `f32`
     /// as the map stores it.
@@ -483,6 +523,7 @@ impl CubeMap {
         let orientation = match options.orientation {
             CubeOrientation::WorldAxes => Quat::IDENTITY,
             CubeOrientation::TowardReceivers | CubeOrientation::Predicted => turned,
+            CubeOrientation::CornerUp => CubeOrientation::turn_corner_up(&relative),
         };
         let mut cube = frame.cube(orientation, options)?;
         let predict = options.orientation == CubeOrientation::Predicted && turned != Quat::IDENTITY;

@@ -246,7 +246,9 @@
 //! smaller predicted error; with [`FaceSizes::ByNeed`] and the eye's samples,
 //! `shadowmap::fit` measures both on the samples instead (over 86 to 88 point-light
 //! cases per seed at seeds 25 and 26 of `compare --sweep 64`: 5% lower p95 `m` on
-//! average, at most 0.1% higher on any case).
+//! average, at most 0.1% higher on any case), and a third beside them, the cube
+//! stood on a corner ([`CubeOrientation::CornerUp`]), whose faces meet a low
+//! lamp's horizon away from their centres.
 //!
 //! The faces share [`CubeOptions::texel_budget`] ([`CubeOptions::sizes`]):
 //! [`FaceSizes::Equal`] gives each the same side (one texture-array layer each, what

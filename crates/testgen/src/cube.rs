@@ -87,9 +87,10 @@ pub fn cube_input(u: &mut Unstructured<'_>) -> GenResult<CubeInput> {
         .with_near(log_uniform(u, 1e-3, 0.5)?)
         .with_focused(u.arbitrary()?)
         .with_reversed_z(u.arbitrary()?)
-        .with_orientation(match u.int_in_range(0u8..=2)? {
+        .with_orientation(match u.int_in_range(0u8..=3)? {
             0 => CubeOrientation::WorldAxes,
             1 => CubeOrientation::TowardReceivers,
+            2 => CubeOrientation::CornerUp,
             _ => CubeOrientation::Predicted,
         });
     // The range sometimes stops short of the view.
@@ -217,7 +218,7 @@ pub fn check_cube(input: &CubeInput, valid: bool) -> Result<(), String> {
     let Light::Point { position, range } = input.light else {
         return Err("fitted a cube for a non-point light".into());
     };
-    check_faces(&cube)?;
+    check_faces(&cube, input.options.orientation)?;
     for p in visible_points(input) {
         check_receiver(&cube, input, p, position, range)?;
     }
@@ -230,7 +231,7 @@ pub(crate) fn near_floor(input: &CubeInput, position: Vec3, range: f32) -> f64 {
     f64::from(input.options.near).max(f64::from(scale) / 131_072.0)
 }
 
-fn check_faces(cube: &CubeMap) -> Result<(), String> {
+fn check_faces(cube: &CubeMap, orientation: CubeOrientation) -> Result<(), String> {
     if cube.faces.is_empty() {
         return Err("no face kept".into());
     }
@@ -247,9 +248,14 @@ fn check_faces(cube: &CubeMap) -> Result<(), String> {
     if order.windows(2).any(|w| w[0] >= w[1]) {
         return Err(format!("faces out of order: {order:?}"));
     }
-    // One orientation for all faces, a turn about the world's Y axis.
+    // One orientation for all faces: a turn about the world's Y axis, or stood on
+    // a corner, the cube's diagonal along it.
     let turn = cube.orientation();
-    let level = (turn * Vec3::Y - Vec3::Y).length() < 1e-5;
+    let up = match orientation {
+        CubeOrientation::CornerUp => Vec3::ONE.normalize(),
+        _ => Vec3::Y,
+    };
+    let level = (turn * up - Vec3::Y).length() < 1e-5;
     if !turn.is_normalized() || !level || cube.faces.iter().any(|f| f.orientation != turn) {
         return Err(format!("bad orientation {turn:?}"));
     }

@@ -11,8 +11,8 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use shadowmap::paraboloid::{
-    CubeOptions, FaceSizes, IpsmOptions, IpsmPlan, ParaboloidMap, Side, SubdivisionOptions,
-    subdivide_triangles,
+    CubeOptions, CubeOrientation, FaceSizes, IpsmOptions, IpsmPlan, ParaboloidMap, Side,
+    SubdivisionOptions, subdivide_triangles,
 };
 use shadowmap::{DpsmOptions, FitInput, Fitted, Shadow, Technique, fit};
 use shadowmap_frustum::{
@@ -462,7 +462,8 @@ fn ipsm_frame_cpu(c: &mut Criterion) {
 /// clipped to each face's window and refined on the GPU, the depth pass drawn
 /// indirectly, uploads flushed; and the fit before it (`cube_rtw_fit`: the oracle's
 /// needs of a 480x270 ground G-buffer, one pair of 256-cell tables per face), with
-/// the cube maps sized by the same samples' needs beside it (`cube_fit_by_need`),
+/// the cube maps sized by the same samples' needs beside it (`cube_fit_by_need`;
+/// `cube_fit_by_need_oriented` with the orientation chosen on them),
 /// and tiled cube maps' fit, depth-pass blocks and caster bins (`cube_tiled_fit`,
 /// `cube_tiled_uniforms`, `cube_tiled_bins`).
 fn cube_rtw_frame_cpu(c: &mut Criterion) {
@@ -493,6 +494,16 @@ fn cube_rtw_frame_cpu(c: &mut Criterion) {
     let by_need = Technique::CubeMaps(CubeOptions::default().with_sizes(FaceSizes::ByNeed));
     c.bench_function("cube_fit_by_need/city_block_lamp_2048", |b| {
         b.iter(|| black_box(fit(black_box(&by_need), &input).is_ok()));
+    });
+    // The same with the orientation chosen on the samples: the world-axis, the
+    // turned and the corner-up cube each sized by them, the least error kept.
+    let oriented = Technique::CubeMaps(
+        CubeOptions::default()
+            .with_sizes(FaceSizes::ByNeed)
+            .with_orientation(CubeOrientation::Predicted),
+    );
+    c.bench_function("cube_fit_by_need_oriented/city_block_lamp_2048", |b| {
+        b.iter(|| black_box(fit(black_box(&oriented), &input).is_ok()));
     });
     // Tiled cube maps on the same input: the fit (the samples' isotropic needs per
     // cell, the quadtree, the packing) and the blocks of its depth pass and lookup.

@@ -29,18 +29,21 @@ pub(crate) fn street() -> (Camera, Light, SceneBounds) {
 #[test]
 fn clip_matrix_agrees_with_the_lookup() {
     let (camera, light, scene) = street();
-    let orientations = [CubeOrientation::WorldAxes, CubeOrientation::TowardReceivers];
-    for (reversed, orientation) in [false, true].into_iter().zip(orientations).chain(
-        [false, true]
-            .into_iter()
-            .zip(orientations.into_iter().rev()),
-    ) {
+    let orientations = [
+        CubeOrientation::WorldAxes,
+        CubeOrientation::TowardReceivers,
+        CubeOrientation::CornerUp,
+    ];
+    let cases = [false, true]
+        .into_iter()
+        .flat_map(|reversed| orientations.map(|o| (reversed, o)));
+    for (reversed, orientation) in cases {
         let options = CubeOptions::default()
             .with_reversed_z(reversed)
             .with_orientation(orientation);
         let cube = CubeMap::fit(&light, &camera, None, &scene, &options).unwrap();
         let turned = cube.orientation() != Quat::IDENTITY;
-        assert_eq!(turned, orientation == CubeOrientation::TowardReceivers);
+        assert_eq!(turned, orientation != CubeOrientation::WorldAxes);
         let mut checked = 0;
         for x in [-40.0, -5.0, 0.0, 7.0, 30.0] {
             for z in [-200.0, -60.0, -31.0, -29.0, -10.0] {
