@@ -12,7 +12,7 @@ use shadowmap_paraboloid::{
     TileOptions, TiledCube,
 };
 use shadowmap_rtw::{
-    AxisNeed, BasePoint, EyeSample, ImportanceMap, WarpMaps, oracle_needs, oracle_needs_where,
+    AxisNeed, BasePoint, EyeSample, ImportanceMap, WarpMaps, oracle_needs, oracle_needs_of,
 };
 
 use crate::fit::{FitError, FitInput, front_lit, is_front_lit, layer_side};
@@ -322,35 +322,39 @@ fn size_by_samples(
     samples: &[EyeSample],
     pixels_per_radian: f32,
 ) -> Result<Option<f64>, FitError> {
-    // At most `MAX_SAMPLES` of them, the front-lit ones (the others are dark
-    // whatever the map holds), each measured on the face that stores it; no
-    // allocation per frame.
+    // At most `MAX_SAMPLES` of them (every `stride`-th), the front-lit ones (the
+    // others are dark whatever the map holds), each measured on the face that
+    // stores it, found once; no allocation per frame.
     let stride = samples.len().div_ceil(MAX_SAMPLES).max(1);
     let light = LightDirection::Position(cube.position);
+    let no_face = u8::MAX;
+    let faces: ArrayVec<u8, MAX_SAMPLES> = samples
+        .iter()
+        .step_by(stride)
+        .take(MAX_SAMPLES)
+        .map(|s| {
+            let face = is_front_lit(s, light)
+                .then(|| cube.map_point(s.position.as_dvec3()))
+                .flatten();
+            face.and_then(|x| u8::try_from(x.layer).ok())
+                .unwrap_or(no_face)
+        })
+        .collect();
     let mut needs: ArrayVec<(usize, f64), MAX_SAMPLES> = ArrayVec::new();
     for layer in 0..cube.layers() {
         let Some(base) = cube.transform(layer) else {
             continue;
         };
-        let stored = |i: usize, s: &EyeSample| {
-            i % stride == 0
-                && is_front_lit(s, light)
-                && cube
-                    .map_point(s.position.as_dvec3())
-                    .is_some_and(|x| x.layer == layer)
-        };
-        oracle_needs_where(
-            &base,
-            input.camera,
-            pixels_per_radian,
-            samples,
-            stored,
-            |_, need| {
-                if need.isotropic.is_finite() && need.isotropic > 0.0 {
-                    let _ = needs.try_push((layer as usize, need.isotropic));
-                }
-            },
-        )?;
+        let stored = faces
+            .iter()
+            .enumerate()
+            .filter(|(_, face)| u32::from(**face) == layer)
+            .filter_map(|(k, _)| Some((k * stride, samples.get(k * stride)?)));
+        oracle_needs_of(&base, input.camera, pixels_per_radian, stored, |_, need| {
+            if need.isotropic.is_finite() && need.isotropic > 0.0 {
+                let _ = needs.try_push((layer as usize, need.isotropic));
+            }
+        })?;
     }
     let densities = face_densities(&mut needs, cube.faces.len());
     let by_need: ArrayVec<Option<[f64; 2]>, 6> = densities

@@ -656,4 +656,4 @@ mod oracle;
 #[cfg(test)]
 mod tests;
 
-pub use oracle::{AxisNeed, PixelSteps, oracle_needs, oracle_needs_where};
+pub use oracle::{AxisNeed, PixelSteps, oracle_needs, oracle_needs_of, oracle_needs_where};

@@ -148,7 +148,8 @@ mod warp;
 pub use error::RtwError;
 pub use importance::{
     AccumulateStats, AxisNeed, BasePoint, EyeSample, ImportanceMap, ImportanceOptions,
-    MAX_MAP_CELLS, MAX_MAP_SIDE, OracleAxis, PixelSteps, oracle_needs, oracle_needs_where,
+    MAX_MAP_CELLS, MAX_MAP_SIDE, OracleAxis, PixelSteps, oracle_needs, oracle_needs_of,
+    oracle_needs_where,
 };
 pub use subdivide::{
     ClipPlane, MAX_CLIP_PLANES, RtwSplitRule, RtwSubdivision, subdivide_for_rtw,

@@ -60,6 +60,24 @@ pub fn oracle_needs_where(
     pixels_per_radian: f32,
     samples: &[EyeSample],
     mut keep: impl FnMut(usize, &EyeSample) -> bool,
+    each: impl FnMut(usize, AxisNeed),
+) -> Result<usize, RtwError> {
+    let kept = samples.iter().enumerate().filter(|(i, s)| keep(*i, s));
+    oracle_needs_of(base, camera, pixels_per_radian, kept, each)
+}
+
+/// [`oracle_needs`] of the samples a caller has already picked, each with the index
+/// `each` is given: for a subset known without looking at every sample (every k-th
+/// sample of those one cube face stores, its faces found once), which
+/// [`oracle_needs_where`] would find by testing them all. No allocation.
+///
+/// # Errors
+/// As [`oracle_needs_where`].
+pub fn oracle_needs_of<'a>(
+    base: &ShadowTransform,
+    camera: &Camera,
+    pixels_per_radian: f32,
+    samples: impl IntoIterator<Item = (usize, &'a EyeSample)>,
     mut each: impl FnMut(usize, AxisNeed),
 ) -> Result<usize, RtwError> {
     if !(pixels_per_radian.is_finite() && pixels_per_radian > 0.0) {
@@ -69,10 +87,7 @@ pub fn oracle_needs_where(
     let base = Base::new(base)?;
     let view = View::new(camera, pixels_per_radian);
     let mut skipped = 0;
-    for (i, s) in samples.iter().enumerate() {
-        if !keep(i, s) {
-            continue;
-        }
+    for (i, s) in samples {
         check_samples(core::slice::from_ref(s))?;
         match view.need(&base, s) {
             Some(need) => each(i, need),

@@ -218,8 +218,9 @@ fn facing_the_base() -> shadowmap_frustum::Camera {
     .unwrap()
 }
 
-/// The kept samples' needs are `oracle_needs`' for them, at their own indices; a
-/// sample not kept is not measured, not counted and not checked.
+/// The kept samples' needs are `oracle_needs`' for them, at their own indices, kept
+/// by a predicate or picked by the caller; a sample not kept is not measured, not
+/// counted and not checked.
 #[test]
 fn oracle_needs_where_measures_only_the_kept_samples() {
     let base = identity_base();
@@ -247,6 +248,11 @@ fn oracle_needs_where_measures_only_the_kept_samples() {
     assert_eq!(skipped, 0);
     let expected: Vec<_> = all.iter().copied().filter(|(i, _)| i % 2 == 0).collect();
     assert_eq!(even, expected);
+    // The same subset picked by the caller: the same needs at the given indices.
+    let mut picked = Vec::new();
+    let evens = samples.iter().enumerate().step_by(2);
+    oracle_needs_of(&base, &camera, 100.0, evens, |i, n| picked.push((i, n))).unwrap();
+    assert_eq!(picked, expected);
     // Kept, the non-finite sample is an error; unchecked by `oracle_needs` it is too.
     let keep_all = oracle_needs_where(&base, &camera, 100.0, &samples, |_, _| true, |_, _| {});
     assert!(matches!(keep_all, Err(RtwError::NonFinite)));
