@@ -12,7 +12,7 @@ use shadowmap_frustum::{
 use shadowmap_warp::{LispsmOptions, WarpedCascades, light_frame, warped_cascades};
 
 use crate::fit::{FitError, FitInput, predictions};
-use crate::held_orientation::least_error_on;
+use crate::held_orientation::error_on;
 use crate::sample_error::{confidently_at_most, percentile_of, sample_error, sample_errors};
 use crate::shadow::Fitted;
 use crate::technique::CascadePlan;
@@ -43,14 +43,15 @@ pub(crate) fn fit_cascades(
     // own, see `CascadeState`), and `state` takes when the choice is made.
     let held = Cell::new(*state);
     // A stable map's new orientation, where the footprint offers rivals to the
-    // view's frame, is chosen on the eye's samples where there are any.
+    // view's frame, and its turn allowance are chosen on the eye's samples where
+    // there are any.
     let samples = directional_samples(input);
     let fit_stable = |splits: &CascadeSplits, options: &CascadeOptions, into: &mut CascadeState| {
         match &samples {
             Some((samples, light)) => {
                 let side = f64::from(options.resolution);
-                let rank = least_error_on(samples, *light, side, input.camera);
-                CascadeSet::fit_with_state_ranked(&camera, direction, splits, options, into, &rank)
+                let error = error_on(samples, *light, side, input.camera);
+                CascadeSet::fit_with_state_ranked(&camera, direction, splits, options, into, &error)
             }
             None => CascadeSet::fit_with_state(&camera, direction, splits, options, into),
         }

@@ -135,16 +135,16 @@ pub struct Cascade {
     pub receivers_missed: bool,
 }
 
-/// A caller's rank of a stable cascade's candidate orientations: given the
-/// candidate cascades over one slice (the view's frame first), the index of the
-/// one to keep (see [`CascadeSet::fit_with_state_ranked`]).
-pub type OrientationRank<'a> = &'a dyn Fn(&[Cascade]) -> usize;
+/// A caller's measure of a stable cascade's candidate maps: the error of one
+/// candidate cascade over its slice, lower is finer (not finite: not measured,
+/// never preferred); see [`CascadeSet::fit_with_state_ranked`].
+pub type CascadeMeasure<'a> = &'a dyn Fn(&Cascade) -> f64;
 
-/// What the stable fit holds across frames, and the caller's rank of new
-/// orientations (see [`CascadeSet::fit_with_state_ranked`]).
+/// What the stable fit holds across frames, and the caller's measure of new
+/// maps (see [`CascadeSet::fit_with_state_ranked`]).
 struct Held<'a> {
     state: &'a mut CascadeState,
-    rank: Option<OrientationRank<'a>>,
+    measure: Option<CascadeMeasure<'a>>,
 }
 
 /// A fitted set of cascades for a directional light.
@@ -258,20 +258,25 @@ impl CascadeSet {
         Self::fit_held(camera, light_direction, splits, options, state, None)
     }
 
-    /// As [`CascadeSet::fit_with_state`], with the caller ranking a stable
-    /// cascade's orientations where a new one is chosen: `rank` is given the
-    /// cascade over the slice in this frame's orientation (first, the one
+    /// As [`CascadeSet::fit_with_state`], with the caller measuring a stable
+    /// cascade's candidate maps where a new one is chosen: `measure` is asked for
+    /// the cascade over the slice in this frame's orientation (first, the one
     /// [`CascadeSet::fit_with_state`] keeps) and in up to
-    /// [`MAX_HELD_CANDIDATES`](crate::MAX_HELD_CANDIDATES)` - 1` others that box the slice ∩ receivers in less
-    /// area, each with a side along an edge of its outline across the light
-    /// (the least-area rectangle around a convex polygon has one: Freeman and
-    /// Shapira, 1975), and returns the index of the one to keep.
+    /// [`MAX_HELD_CANDIDATES`](crate::MAX_HELD_CANDIDATES)` - 1` others that box
+    /// the slice ∩ receivers in less area, each with a side along an edge of its
+    /// outline across the light (the least-area rectangle around a convex polygon
+    /// has one: Freeman and Shapira, 1975); the least error is kept (the first on
+    /// ties). Where the turn allowance ([`STABLE_TURN`](crate::STABLE_TURN))
+    /// widens the kept map, it is asked for the tight box of the slice in this
+    /// frame's orientation, and where the kept map measures more than
+    /// [`STABLE_MAX_OVER_TIGHT`](crate::STABLE_MAX_OVER_TIGHT) times that, for
+    /// the kept orientation's map without the allowance, kept instead where finer.
     ///
     /// A frame that follows the view boxes a footprint cut by a room's walls at
     /// whatever angle the view makes with them; a frame along the walls can hold
     /// the same footprint, turn allowance included, in half the area. Less area
     /// is not always finer where the eye looks (the texels' shape and orientation
-    /// against the view count too), so the choice is the caller's: a renderer with
+    /// against the view count too), so the measure is the caller's: a renderer with
     /// the frame's visible samples (a depth and normal buffer) measures each
     /// candidate's error on them, as `shadowmap::fit` does.
     ///
@@ -283,9 +288,16 @@ impl CascadeSet {
         splits: &CascadeSplits,
         options: &CascadeOptions,
         state: &mut CascadeState,
-        rank: OrientationRank<'_>,
+        measure: CascadeMeasure<'_>,
     ) -> Result<Self, FrustumError> {
-        Self::fit_held(camera, light_direction, splits, options, state, Some(rank))
+        Self::fit_held(
+            camera,
+            light_direction,
+            splits,
+            options,
+            state,
+            Some(measure),
+        )
     }
 
     fn fit_held(
@@ -294,12 +306,12 @@ impl CascadeSet {
         splits: &CascadeSplits,
         options: &CascadeOptions,
         state: &mut CascadeState,
-        rank: Option<OrientationRank<'_>>,
+        measure: Option<CascadeMeasure<'_>>,
     ) -> Result<Self, FrustumError> {
         let mut next = *state;
         let held = Some(Held {
             state: &mut next,
-            rank,
+            measure,
         });
         let set = Self::fit_inner(camera, light_direction, splits, options, held)?;
         *state = next;
@@ -344,8 +356,8 @@ impl CascadeSet {
         let mut state = None;
         if let Some(held) = held {
             state = Some(held.state);
-            if let Some(rank) = held.rank {
-                fitter.rank_with(rank);
+            if let Some(measure) = held.measure {
+                fitter.measure_with(measure);
             }
         }
         let (splits, set) = (&self.splits, &mut self.cascades);

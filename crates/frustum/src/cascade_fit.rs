@@ -3,7 +3,7 @@
 //! then each slice's light-space box (tight, stable sphere, stable ladder, or held
 //! across frames), its depth range pulled back to the casters, and its matrices.
 
-use core::cell::Cell;
+use core::cell::RefCell;
 
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
@@ -11,8 +11,8 @@ use glam::{DMat4, DVec2, DVec3, Mat4, Vec3};
 use crate::body::ConvexBody;
 use crate::bounding_sphere::{bounding_sphere, symmetric_slice_sphere};
 use crate::camera::CameraGeometry;
-use crate::cascade::{Cascade, CascadeFit, CascadeOptions, OrientationRank};
-use crate::cascade_state::{ChooseBox, HeldBox, HeldSlot, MAX_HELD_CANDIDATES, held_box};
+use crate::cascade::{Cascade, CascadeFit, CascadeMeasure, CascadeOptions};
+use crate::cascade_state::{HeldBox, HeldSlot, MAX_HELD_CANDIDATES, MeasureBox, held_box};
 use crate::light::unit;
 use crate::light_prism::LightPrism;
 use crate::mapping::{LightDirection, ShadowTransform};
@@ -43,9 +43,9 @@ pub fn fit_cascade(
 /// per call of [`CascadeSet::fit`](crate::CascadeSet::fit).
 pub(crate) struct Fitter<'a> {
     camera: &'a CameraGeometry,
-    /// The caller's rank of a stable cascade's candidate orientations (see
+    /// The caller's measure of a stable cascade's candidate maps (see
     /// [`CascadeSet::fit_with_state_ranked`](crate::CascadeSet::fit_with_state_ranked)).
-    rank: Option<OrientationRank<'a>>,
+    measure: Option<CascadeMeasure<'a>>,
     light_dir: DVec3,
     light_from_world: DMat4,
     /// `light_from_world` in `f32`, as stored in every cascade.
@@ -99,7 +99,7 @@ impl<'a> Fitter<'a> {
         let view = &camera.world_from_view;
         Self {
             camera,
-            rank: None,
+            measure: None,
             light_dir,
             light_from_world,
             light_from_world32: light_from_world.as_mat4(),
@@ -119,9 +119,9 @@ impl<'a> Fitter<'a> {
         }
     }
 
-    /// Gives the stable fit the caller's rank of candidate orientations.
-    pub(crate) fn rank_with(&mut self, rank: OrientationRank<'a>) {
-        self.rank = Some(rank);
+    /// Gives the stable fit the caller's measure of candidate maps.
+    pub(crate) fn measure_with(&mut self, measure: CascadeMeasure<'a>) {
+        self.measure = Some(measure);
     }
 
     /// The view depths `[near, far]` checked against the camera's range, in `f64`.
@@ -337,10 +337,10 @@ impl<'a> Fitter<'a> {
 
     /// The stable fit with a caller-held map ([`held_box`]): a box over
     /// slice ∩ receivers whose extents and orientation are kept across frames.
-    /// Where a new orientation is chosen and frames along the footprint's edges box
-    /// it in less area than this frame's, the caller's rank (see
+    /// Where a new map is chosen, the caller's measure (see
     /// [`CascadeSet::fit_with_state_ranked`](crate::CascadeSet::fit_with_state_ranked))
-    /// chooses among them; without one, this frame's.
+    /// chooses among this frame's orientation and frames along the footprint's
+    /// edges, and prices the turn allowance; without one, this frame's.
     fn fit_held(
         &self,
         n: f64,
@@ -350,12 +350,21 @@ impl<'a> Fitter<'a> {
     ) -> Result<Cascade, FrustumError> {
         let body = self.receivers_body(n, f, scene)?;
         let points = body.iter().map(|v| v.as_dvec3());
-        // The rank builds every candidate's cascade; the one it chooses is kept.
-        let ranked_cascade = Cell::new(None);
-        let choose = |boxes: &[HeldBox]| {
-            let (index, cascade) = self.ranked(n, f, &points, boxes, scene);
-            ranked_cascade.set(cascade);
-            index
+        // The cascades the measure built, so that the kept one is not built again.
+        let measured: RefCell<ArrayVec<(HeldBox, Cascade), MEASURED>> = RefCell::default();
+        let measure = |b: &HeldBox| {
+            let Some(measure) = self.measure else {
+                return f64::INFINITY;
+            };
+            let Ok(cascade) = self.held_cascade(n, f, &points, b, scene) else {
+                return f64::INFINITY;
+            };
+            let mut measured = measured.borrow_mut();
+            if measured.is_full() {
+                measured.remove(0);
+            }
+            measured.push((*b, cascade));
+            measure(&cascade)
         };
         let b = held_box(
             &points,
@@ -364,38 +373,13 @@ impl<'a> Fitter<'a> {
             &self.light_from_world,
             f64::from(self.options.resolution),
             held,
-            self.rank.map(|_| &choose as ChooseBox<'_>),
+            self.measure.map(|_| &measure as MeasureBox<'_>),
         )?;
-        match ranked_cascade.take() {
+        let built = measured.borrow().iter().find(|(m, _)| *m == b).map(|m| m.1);
+        match built {
             Some(cascade) => Ok(cascade),
             None => self.held_cascade(n, f, &points, &b, scene),
         }
-    }
-
-    /// The index in `boxes` (this frame's orientation first) the caller's rank
-    /// chooses among their cascades over slice `[n, f]`, and the chosen cascade;
-    /// the first index (and no cascade) without a rank or where a cascade fails.
-    fn ranked(
-        &self,
-        n: f64,
-        f: f64,
-        points: &(impl Iterator<Item = DVec3> + Clone),
-        boxes: &[HeldBox],
-        scene: &SceneBounds,
-    ) -> (usize, Option<Cascade>) {
-        let Some(rank) = self.rank else {
-            return (0, None);
-        };
-        let mut cascades: ArrayVec<Cascade, MAX_HELD_CANDIDATES> = ArrayVec::new();
-        for b in boxes.iter().take(MAX_HELD_CANDIDATES) {
-            match self.held_cascade(n, f, points, b, scene) {
-                Ok(c) => cascades.push(c),
-                Err(_) => return (0, None),
-            }
-        }
-        // An index past the candidates: `held_box` keeps the last, fitted again.
-        let index = rank(&cascades);
-        (index, cascades.get(index).copied())
     }
 
     /// The cascade of slice `[n, f]` over `points` (slice ∩ receivers) in the
@@ -537,6 +521,10 @@ pub(crate) struct FittedBox {
     /// (`None`: not computed; the slice's extent is then read if the test needs it).
     reach: Option<f64>,
 }
+
+/// Most measured cascades a stable fit keeps to return the chosen one from:
+/// every orientation's and the chosen one's without the turn allowance.
+const MEASURED: usize = MAX_HELD_CANDIDATES + 2;
 
 /// The tight box of the light-space bounds `[lo, hi]` (a footprint seen edge-on
 /// given a sliver of area) and its texel size (the larger side's).

@@ -43,6 +43,25 @@ pub const STABLE_TURN: f64 = 0.1;
 /// camera does not turn.
 pub const STABLE_HEADROOM: f64 = 1.03;
 
+/// Largest ratio of a new stable cascade's error on the caller's measure (see
+/// [`CascadeSet::fit_with_state_ranked`](crate::CascadeSet::fit_with_state_ranked)),
+/// its turn allowance (see [`STABLE_TURN`]) included, to the tight box of the same
+/// slice in this frame's orientation (the box the tight and uniform fits draw);
+/// above it the map is sized with [`STABLE_HEADROOM`] alone where that measures
+/// finer, and a turn of the camera re-sizes it once.
+///
+/// A turn grows a footprint's box across by its length times the angle, so the
+/// allowance costs little on a compact footprint and much on a long one: a room
+/// seen along its length under a high light (a 5:1 footprint) pays 27% across, and
+/// the map with it measured 1.10 times the tight box. Where the stable map's own
+/// orientation already beats the view's frame (a top-down view, whose map turned
+/// along the footprint measures about 0.85 times the tight box) the allowance is
+/// kept however much it costs, so the camera turns without a pop. With the
+/// allowance dropped, the headroom (3%), the short-mantissa round-up (at most
+/// 1.6%) and a texel of snap slack keep a new map within about 1.06 times the
+/// tight box of its slice.
+pub const STABLE_MAX_OVER_TIGHT: f64 = 1.08;
+
 /// Largest ratio of a held size to the size it would be (re)chosen at before the
 /// map shrinks. Shrinking only gives texels back (a map that is too big still
 /// covers), so the band is wider on this side.
@@ -104,7 +123,8 @@ struct HeldMap {
 /// it choose new ones, in the orientation the caller asks for this frame
 /// ([`CascadeOptions::up_hint`](crate::CascadeOptions::up_hint)): the footprint's
 /// extents turned by up to [`STABLE_TURN`], or times [`STABLE_HEADROOM`] where that
-/// is larger. While the
+/// is larger (the headroom alone where the caller's measure finds the map with
+/// the allowance more than [`STABLE_MAX_OVER_TIGHT`] times the tight box). While the
 /// extents are kept the box is snapped to whole texels of a grid anchored at the
 /// held light frame's origin, so the map moves by whole texels and shadow edges do
 /// not shimmer. Unlike the bounding sphere of the whole slice (the stateless stable
@@ -113,7 +133,7 @@ struct HeldMap {
 /// one that fits them when it is chosen rather than one fixed in the world (a
 /// footprint at 45° to a world-fixed frame needs a box up to 1.41 times larger):
 /// the view's, or one along an edge of the footprint that boxes it in less area,
-/// where the caller ranks those
+/// where the caller measures those
 /// ([`CascadeSet::fit_with_state_ranked`](crate::CascadeSet::fit_with_state_ranked)).
 ///
 /// The held sizes stay only while the slices stay: split a depth range held by
@@ -363,11 +383,12 @@ fn with_slack(extent: DVec2, scale: f64, res: f64) -> Result<DVec2, FrustumError
     }
 }
 
-/// Chooses among candidate boxes (this frame's orientation first) by index.
-pub(crate) type ChooseBox<'a> = &'a dyn Fn(&[HeldBox]) -> usize;
+/// The caller's error of a candidate box (lower is finer; not finite: not
+/// measured), see [`CascadeMeasure`](crate::CascadeMeasure).
+pub(crate) type MeasureBox<'a> = &'a dyn Fn(&HeldBox) -> f64;
 
 /// A stable cascade's box, chosen by [`held_box`].
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct HeldBox {
     /// The light frame (rotation) the box lies in.
     pub(crate) light_from_world: DMat4,
@@ -388,6 +409,11 @@ pub(crate) struct HeldBox {
 /// The turned footprint (see [`STABLE_TURN`]) is capped by the receivers' box: no
 /// turn or walk of the camera gives a footprint larger than the box's own, so a
 /// slice that sees most of a room pays no turn allowance beyond the room.
+///
+/// With the caller's `measure`, a new box is chosen among this frame's
+/// orientation and its rivals (the least error, the first on ties), and its turn
+/// allowance is kept only where the box measures within [`STABLE_MAX_OVER_TIGHT`]
+/// of the tight box in this frame's orientation (see there).
 pub(crate) fn held_box(
     points: &(impl Iterator<Item = DVec3> + Clone),
     receivers: &Aabb,
@@ -395,7 +421,7 @@ pub(crate) fn held_box(
     frame: &DMat4,
     res: f64,
     held: &mut HeldSlot<'_>,
-    choose: Option<ChooseBox<'_>>,
+    measure: Option<MeasureBox<'_>>,
 ) -> Result<HeldBox, FrustumError> {
     let fit = Fit {
         receivers,
@@ -404,7 +430,7 @@ pub(crate) fn held_box(
     };
     if let Some(up) = held.up_for(direction) {
         let light = light_rotation(direction, up);
-        let (b, _, kept) = fit.boxed(points, light, held.0.side)?;
+        let (b, _, kept) = fit.boxed(points, light, held.0.side, true)?;
         if kept {
             return Ok(b);
         }
@@ -413,35 +439,22 @@ pub(crate) fn held_box(
     // f32 and the frame rebuilt from it, so that the frames that keep it rebuild
     // exactly the same rotation.
     let own = DVec3::new(frame.x_axis.y, frame.y_axis.y, frame.z_axis.y).as_vec3();
-    let mut boxes: ArrayVec<(HeldBox, DVec2, Vec3), MAX_HELD_CANDIDATES> = ArrayVec::new();
-    let (b, side, _) = fit.boxed(points, light_rotation(direction, own), DVec2::ZERO)?;
-    boxes.push((b, side, own));
-    // Rivals only for a caller that ranks them.
-    if choose.is_some() {
-        for up in rivals(points, direction, own, side, &fit)? {
-            let (b, side, _) = fit.boxed(points, light_rotation(direction, up), DVec2::ZERO)?;
-            boxes.push((b, side, up));
-        }
-    }
-    let chosen = match choose {
-        Some(choose) if boxes.len() > 1 => {
-            let candidates: ArrayVec<HeldBox, MAX_HELD_CANDIDATES> =
-                boxes.iter().map(|b| b.0).collect();
-            choose(&candidates).min(boxes.len() - 1)
-        }
-        _ => 0,
+    let (b, map) = match measure {
+        Some(measure) => fit.measured(points, direction, own, measure)?,
+        None => fit.new_box(points, direction, own, true)?,
     };
-    let (b, side, up) = boxes[chosen];
-    *held.0 = HeldMap { side, up };
+    *held.0 = map;
     Ok(b)
 }
 
 /// Most orientations besides the frame's own that a new stable box is chosen among.
 const RIVALS: usize = 3;
 
-/// Most candidate cascades a rank of a stable cascade's orientations is given
-/// (see [`CascadeSet::fit_with_state_ranked`](crate::CascadeSet::fit_with_state_ranked)):
-/// this frame's orientation and its rivals.
+/// Most orientations a new stable cascade's map is chosen among on the caller's
+/// measure (see [`CascadeSet::fit_with_state_ranked`](crate::CascadeSet::fit_with_state_ranked)):
+/// this frame's orientation and its rivals. The measure is asked at most twice
+/// more: for the tight box in this frame's orientation and for the chosen
+/// orientation without its turn allowance.
 pub const MAX_HELD_CANDIDATES: usize = 1 + RIVALS;
 
 /// The orientations along edges of the footprint's hull across the light
@@ -462,7 +475,7 @@ fn rivals(
     let own_area = own_side.x * own_side.y;
     let mut smaller: ArrayVec<(f64, Vec3), MAX_HULL> = ArrayVec::new();
     for up in edge_ups(&hull, &own_frame) {
-        let (_, side, _) = fit.boxed(&corners, light_rotation(direction, up), DVec2::ZERO)?;
+        let (_, side, _) = fit.boxed(&corners, light_rotation(direction, up), DVec2::ZERO, true)?;
         let area = side.x * side.y;
         let new = smaller.iter().all(|(a, _)| (area - a).abs() > 1e-9 * area);
         if area < own_area * (1.0 - 1e-6) && new {
@@ -482,14 +495,93 @@ struct Fit<'a> {
 }
 
 impl Fit<'_> {
+    /// A new box over `points` in the frame oriented by `up` about the light
+    /// `direction`, with the turn allowance or (not `turn`) without, and the map
+    /// it holds.
+    fn new_box(
+        &self,
+        points: &(impl Iterator<Item = DVec3> + Clone),
+        direction: DVec3,
+        up: Vec3,
+        turn: bool,
+    ) -> Result<(HeldBox, HeldMap), FrustumError> {
+        let light = light_rotation(direction, up);
+        let (b, side, _) = self.boxed(points, light, DVec2::ZERO, turn)?;
+        Ok((b, HeldMap { side, up }))
+    }
+
+    /// The new box of least error on `measure` among this frame's orientation
+    /// `own` (first on ties) and its rivals, without its turn allowance where the
+    /// box with it measures more than [`STABLE_MAX_OVER_TIGHT`] times the tight
+    /// box in `own` and without measures finer. Not finite errors never win, and
+    /// keep the allowance. Measures only what decides: nothing for a lone
+    /// orientation whose sides are within the bound of the tight box's.
+    fn measured(
+        &self,
+        points: &(impl Iterator<Item = DVec3> + Clone),
+        direction: DVec3,
+        own: Vec3,
+        measure: MeasureBox<'_>,
+    ) -> Result<(HeldBox, HeldMap), FrustumError> {
+        let mut best = self.new_box(points, direction, own, true)?;
+        let mut best_error = None;
+        for up in rivals(points, direction, own, best.1.side, self)? {
+            let least = *best_error.get_or_insert_with(|| measure(&best.0));
+            let candidate = self.new_box(points, direction, up, true)?;
+            let error = measure(&candidate.0);
+            if error < least * (1.0 - 1e-9) || (!least.is_finite() && error.is_finite()) {
+                (best, best_error) = (candidate, Some(error));
+            }
+        }
+        let unturned = self.new_box(points, direction, best.1.up, false)?;
+        let tight = self.tight(points, light_rotation(direction, own));
+        // In the same frame an orthographic map's error grows at most as its
+        // texels' sides: within the bound on both, it is within it on the measure.
+        let within = best.1.up == own
+            && best
+                .1
+                .side
+                .cmple((tight.hi - tight.lo) * STABLE_MAX_OVER_TIGHT)
+                .all();
+        if unturned.1.side == best.1.side || within {
+            return Ok(best);
+        }
+        let best_error = best_error.unwrap_or_else(|| measure(&best.0));
+        let tight = measure(&tight);
+        let over = best_error.is_finite() && tight.is_finite();
+        if over && best_error > STABLE_MAX_OVER_TIGHT * tight && measure(&unturned.0) < best_error {
+            return Ok(unturned);
+        }
+        Ok(best)
+    }
+
+    /// The tight box over `points` in the frame `light`: their bounds, no margin,
+    /// no snap.
+    fn tight(&self, points: &(impl Iterator<Item = DVec3> + Clone), light: DMat4) -> HeldBox {
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for p in points.clone() {
+            let q = light.transform_point3(p).truncate();
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+        HeldBox {
+            light_from_world: light,
+            lo,
+            hi,
+            texel: (hi - lo).max_element() / self.res,
+        }
+    }
+
     /// The box over `points` in the frame `light` with the extents [`hold_side`]
-    /// keeps or chooses from `held` (zero: none), its extents and whether `held`
-    /// was kept; the centre snapped to whole texels.
+    /// keeps or chooses from `held` (zero: none), with the turn allowance or (not
+    /// `turn`) the headroom alone, its extents and whether `held` was kept; the
+    /// centre snapped to whole texels.
     fn boxed(
         &self,
         points: &(impl Iterator<Item = DVec3> + Clone),
         light: DMat4,
         held: DVec2,
+        turn: bool,
     ) -> Result<(HeldBox, DVec2, bool), FrustumError> {
         let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
         for p in points.clone() {
@@ -500,6 +592,9 @@ impl Fit<'_> {
         let scale = lo.abs().max(hi.abs()).max_element();
         let needed = with_slack(hi - lo, scale, self.res)?;
         let turned = || {
+            if !turn {
+                return Ok(needed);
+            }
             let turned =
                 turned_extent(points, &light, self.phi).min(box_extent(self.receivers, &light));
             with_slack(turned, scale, self.res)
@@ -518,227 +613,4 @@ impl Fit<'_> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `hold_side` with a known turned footprint.
-    fn hold(held: DVec2, needed: DVec2, turned: DVec2) -> (DVec2, bool) {
-        hold_side(held, needed, || Ok(turned)).unwrap()
-    }
-
-    #[test]
-    fn size_is_kept_inside_the_band_and_renewed_outside() {
-        let n = DVec2::new(10.0, 4.0);
-        let turned = DVec2::new(10.2, 4.9);
-        let (first, kept) = hold(DVec2::ZERO, n, turned);
-        assert!(!kept);
-        // The turned footprint, or the footprint with the headroom where that is
-        // larger (x here), rounded up by less than 2%.
-        let target = DVec2::new(n.x * STABLE_HEADROOM, turned.y);
-        assert!(first.cmpge(target).all() && first.cmple(target * 1.016).all());
-        // Grows within the margin: still covered, kept.
-        assert_eq!(hold(first, n * 1.02, turned * 1.02), (first, true));
-        assert_eq!(hold(first, DVec2::new(10.0, 4.8), turned), (first, true));
-        // Grows past it: renewed from the new footprint.
-        let (renewed, kept) = hold(first, n * 1.3, turned * 1.3);
-        assert!(!kept && renewed.cmpge(turned * 1.3).all());
-        assert!(renewed.cmpge(n * 1.3 * STABLE_HEADROOM).all());
-        // Shrinks to 80%: kept; to 60%: the held map is more than 1.5 times the size
-        // it would be chosen at, renewed.
-        assert!(hold(first, n * 0.8, turned * 0.8).1);
-        let (smaller, kept) = hold(first, n * 0.6, turned * 0.6);
-        assert!(!kept && smaller.cmplt(first).all());
-        // One axis too small renews both.
-        let (both, kept) = hold(first, DVec2::new(9.0, 8.0), DVec2::new(10.0, 8.0));
-        assert!(!kept && both.y >= 8.0 * STABLE_HEADROOM && both.x < first.x);
-    }
-
-    #[test]
-    fn the_turned_footprint_is_computed_only_where_it_decides() {
-        let n = DVec2::new(10.0, 4.0);
-        let turned = DVec2::new(10.2, 4.9);
-        let (first, _) = hold(DVec2::ZERO, n, turned);
-        // Covered and within the band over the headroom alone: not asked for, and
-        // the same choice as with it.
-        let unasked = || -> Result<DVec2, FrustumError> { panic!("turned footprint asked for") };
-        assert_eq!(hold_side(first, n, unasked).unwrap(), (first, true));
-        assert_eq!(hold(first, n, turned), (first, true));
-        // Where the turn needs much more than the headroom, a footprint shrunk to
-        // 70% keeps the held size only by its turned extent (held y about 6.06,
-        // over 0.7 * 4 * 1.03 more than 1.5 times, over 0.7 * 6 less).
-        let wide_turn = DVec2::new(10.2, 6.0);
-        let (first, _) = hold(DVec2::ZERO, n, wide_turn);
-        assert_eq!(hold(first, n * 0.7, wide_turn * 0.7), (first, true));
-        assert!(!hold(first, n * 0.7, n * 0.7).1);
-        // Its error reaches the caller where it is needed.
-        let failing = || Err(FrustumError::EmptyBounds);
-        assert_eq!(
-            hold_side(DVec2::ZERO, n, failing),
-            Err(FrustumError::EmptyBounds)
-        );
-    }
-
-    #[test]
-    fn a_turned_footprint_needs_its_long_side_times_the_turn_across() {
-        // A 5 x 1 rectangle in the light frame of a light straight down: turned by
-        // phi, its box grows to 5 cos + sin by 5 sin + cos.
-        let light = crate::projection::light_rotation(DVec3::NEG_Y, Vec3::Z);
-        let world = |x: f64, y: f64| light.inverse().transform_point3(DVec3::new(x, y, 0.0));
-        let corners = [
-            world(0.0, 0.0),
-            world(5.0, 0.0),
-            world(5.0, 1.0),
-            world(0.0, 1.0),
-        ];
-        let phi = 0.1;
-        let e = turned_extent(&corners.iter().copied(), &light, phi);
-        let (s, c) = (phi.sin(), phi.cos());
-        assert!((e.x - (5.0 * c + s)).abs() < 1e-9, "{e}");
-        assert!((e.y - (5.0 * s + c)).abs() < 1e-9, "{e}");
-        assert_eq!(
-            turned_extent(&corners.iter().copied(), &light, 0.0),
-            DVec2::new(5.0, 1.0)
-        );
-    }
-
-    #[test]
-    fn the_held_depth_range_rides_out_jumps_and_creep_within_the_camera_range() {
-        let limits = (1.0, 1000.0);
-        let mut state = CascadeState::new();
-        let first = state.hold_depth_range(55.0, 160.0, limits);
-        assert_eq!(first.split, (55.0, 160.0));
-        assert_eq!(first.cover, (44.0, 200.0));
-        // The far bound creeps by 3% a frame, the near one jumps by a fifth: the
-        // same ranges for seven frames.
-        for k in 1..=7 {
-            let near = if k > 2 { 66.0 } else { 55.0 };
-            let far = 160.0 * 1.03f32.powi(k);
-            assert_eq!(state.hold_depth_range(near, far, limits), first, "{k}");
-        }
-        // Past the far margin: a new far end, the near end kept.
-        let r = state.hold_depth_range(55.0, 210.0, limits);
-        assert_eq!((r.split, r.cover), ((55.0, 210.0), (44.0, 262.5)));
-        // Far too wide once the bound has come much nearer: a new far end.
-        let r = state.hold_depth_range(55.0, 100.0, limits);
-        assert_eq!((r.split.1, r.cover.1), (100.0, 125.0));
-        // Whatever the bounds, the ranges nest inside the camera's.
-        for (near, far) in [
-            (f32::NAN, 5.0),
-            (500.0, 20.0),
-            (-3.0, f32::INFINITY),
-            (2000.0, 3000.0),
-            (0.5, 1e9),
-        ] {
-            let r = state.hold_depth_range(near, far, limits);
-            let (c, s) = (r.cover, r.split);
-            assert!(
-                limits.0 <= c.0 && c.0 <= s.0 && s.0 <= s.1 && s.1 <= c.1 && c.1 <= limits.1,
-                "{near} {far} -> {r:?}"
-            );
-        }
-    }
-
-    #[test]
-    fn short_mantissa_rounds_up_by_at_most_two_percent() {
-        for x in [1e-3, 0.37, 1.0, 3.3, 1234.5678, 9.9e6] {
-            let r = short_mantissa_above(x);
-            assert!(r >= x && r <= x * (1.0 + 1.0 / 64.0), "{x} -> {r}");
-            // Six mantissa bits: times 64 over its power of two is an integer.
-            let scaled = r / 2f64.powi(r.log2().floor() as i32) * 64.0;
-            assert_eq!(scaled, scaled.round(), "{r}");
-        }
-    }
-
-    #[test]
-    fn the_turn_allowance_stops_at_the_receivers_box() {
-        // A light straight down on a 10 x 4 floor seen whole: turned by 0.1 rad the
-        // floor's box would grow to about 10.35 x 4.98, but no view of the floor
-        // has a footprint larger than the floor.
-        let res = 1024.0;
-        let direction = DVec3::NEG_Y;
-        let frame = crate::projection::light_rotation(direction, Vec3::Z);
-        let floor = Aabb::new(Vec3::new(0.0, -1.0, 0.0), Vec3::new(10.0, 0.0, 4.0));
-        let corners: [DVec3; 8] = core::array::from_fn(|i| {
-            DVec3::select(
-                glam::BVec3::new(i & 1 != 0, i & 2 != 0, i & 4 != 0),
-                floor.max.as_dvec3(),
-                floor.min.as_dvec3(),
-            )
-        });
-        let mut state = CascadeState::new();
-        let mut slot = state.slot(1, 0).unwrap();
-        let b = held_box(
-            &corners.iter().copied(),
-            &floor,
-            direction,
-            &frame,
-            res,
-            &mut slot,
-            None,
-        )
-        .unwrap();
-        let (turned, cap) = (
-            turned_extent(&corners.iter().copied(), &frame, STABLE_TURN),
-            box_extent(&floor, &frame),
-        );
-        assert!(turned.min_element() > 4.9 && (cap.max_element() - 10.0).abs() < 1e-9);
-        // The footprint with the headroom (one texel of slack, a short mantissa).
-        let side = b.hi - b.lo;
-        let least = cap * STABLE_HEADROOM;
-        assert!(
-            side.cmpge(least).all() && side.cmple(least * 1.02).all(),
-            "{side}"
-        );
-    }
-
-    #[test]
-    fn held_box_moves_by_whole_texels_covers_the_footprint_and_keeps_its_frame() {
-        let res = 512.0;
-        let direction = DVec3::new(0.3, -1.0, 0.2).normalize();
-        let frame = crate::projection::light_rotation(direction, Vec3::X);
-        let other = crate::projection::light_rotation(direction, Vec3::Z);
-        let footprint = [
-            DVec3::new(-3.2, 0.0, 7.1),
-            DVec3::new(40.3, 0.0, 19.9),
-            DVec3::new(10.0, 5.0, -4.0),
-            DVec3::new(22.0, 1.0, 30.0),
-        ];
-        let mut state = CascadeState::new();
-        let receivers = Aabb::new(Vec3::splat(-200.0), Vec3::splat(200.0));
-        let mut fit = |points: &[DVec3], frame: &DMat4| {
-            let mut slot = state.slot(1, 0).unwrap();
-            let points = points.iter().copied();
-            held_box(&points, &receivers, direction, frame, res, &mut slot, None).unwrap()
-        };
-        let a = fit(&footprint, &frame);
-        let covers = |b: &HeldBox, shift: DVec3| {
-            footprint.iter().all(|p| {
-                let q = b.light_from_world.transform_point3(*p + shift).truncate();
-                q.cmpge(b.lo).all() && q.cmple(b.hi).all()
-            })
-        };
-        assert!(covers(&a, DVec3::ZERO));
-        // Moved: the same frame and size (even when asked for another frame), by
-        // whole texels.
-        let shift = DVec3::new(1.37, -0.2, -0.61);
-        let moved: Vec<DVec3> = footprint.iter().map(|p| *p + shift).collect();
-        let b = fit(&moved, &other);
-        assert!(covers(&b, shift));
-        assert_eq!(b.light_from_world, a.light_from_world);
-        assert_eq!(b.hi - b.lo, a.hi - a.lo);
-        let texel = (a.hi - a.lo) / res;
-        let steps = (b.lo - a.lo) / texel;
-        assert!(
-            (steps - steps.round()).abs().max_element() < 1e-9,
-            "{steps}"
-        );
-        // Three times larger: re-sized, in the frame asked for now.
-        let big: Vec<DVec3> = footprint.iter().map(|p| *p * 3.0).collect();
-        let c = fit(&big, &other);
-        assert!((c.light_from_world.y_axis - other.y_axis).length() < 1e-6);
-        assert!(c.texel > 2.0 * a.texel);
-        assert!(
-            state.size(1, 0).is_some() && state.size(1, 1).is_none() && state.size(2, 0).is_none()
-        );
-    }
-}
+mod tests;

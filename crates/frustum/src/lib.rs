@@ -113,11 +113,11 @@ mod serde_impls;
 
 pub use body::{ConvexBody, MAX_BODY_VERTICES};
 pub use camera::{Camera, Projection};
-pub use cascade::{Cascade, CascadeFit, CascadeOptions, CascadeSet, OrientationRank};
+pub use cascade::{Cascade, CascadeFit, CascadeMeasure, CascadeOptions, CascadeSet};
 pub use cascade_fit::fit_cascade;
 pub use cascade_state::{
     CascadeState, HeldDepthRange, MAX_HELD_CANDIDATES, STABLE_DEPTH_MARGIN, STABLE_HEADROOM,
-    STABLE_SHRINK_RATIO, STABLE_TURN,
+    STABLE_MAX_OVER_TIGHT, STABLE_SHRINK_RATIO, STABLE_TURN,
 };
 pub use clip::MAX_FRUSTUM_AABB_VERTICES;
 pub use depth_bounds::DepthBounds;

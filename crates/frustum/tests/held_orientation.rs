@@ -1,6 +1,6 @@
-//! The stable fit's new orientations (`CascadeSet::fit_with_state_ranked`): what
-//! the rank is offered, that its choice is kept, and that every candidate covers
-//! the visible receivers.
+//! The stable fit's new maps (`CascadeSet::fit_with_state_ranked`): what the
+//! caller's measure is asked for, that its choice is kept, and that every
+//! candidate covers the visible receivers.
 
 use std::cell::RefCell;
 
@@ -72,9 +72,12 @@ fn seen(camera: &ValidCamera, (n, f): (f32, f32)) -> Vec<Vec3> {
     out
 }
 
-/// The candidates each call of the rank was offered.
+/// The candidates the measure was asked for, by slice.
 type Offers = RefCell<Vec<Vec<Cascade>>>;
 
+/// The fit with a measure that finds candidate `pick` of each slice finest (1,
+/// the others 2): the orientations in the order offered, then, where the turn
+/// allowance widens the kept one, the tight box and the kept one without it.
 fn ranked(
     camera: &ValidCamera,
     state: &mut CascadeState,
@@ -82,11 +85,19 @@ fn ranked(
     pick: usize,
     offers: &Offers,
 ) -> CascadeSet {
-    let rank = |candidates: &[Cascade]| {
-        offers.borrow_mut().push(candidates.to_vec());
-        pick
+    let measure = |c: &Cascade| {
+        let mut offers = offers.borrow_mut();
+        match offers.last_mut() {
+            Some(slice) if slice[0].view_depth == c.view_depth => slice.push(*c),
+            _ => offers.push(vec![*c]),
+        }
+        if offers.last().unwrap().len() == pick + 1 {
+            1.0
+        } else {
+            2.0
+        }
     };
-    CascadeSet::fit_with_state_ranked(camera, LIGHT, &splits(count), &options(), state, &rank)
+    CascadeSet::fit_with_state_ranked(camera, LIGHT, &splits(count), &options(), state, &measure)
         .unwrap()
 }
 
@@ -102,7 +113,7 @@ fn the_first_candidate_is_the_unranked_fit_and_the_choice_is_held() {
     assert_eq!(first, own);
     let offered = offers.borrow()[0].clone();
     assert!(
-        (2..=MAX_HELD_CANDIDATES).contains(&offered.len()),
+        (2..=MAX_HELD_CANDIDATES + 2).contains(&offered.len()),
         "a view diagonal to the walls is offered rivals: {}",
         offered.len()
     );
@@ -116,10 +127,25 @@ fn the_first_candidate_is_the_unranked_fit_and_the_choice_is_held() {
     let again = ranked(&camera, &mut state, 1, 0, &offers);
     assert_eq!(again.cascades[0].transform, offered[1].transform);
     assert_eq!(offers.borrow().len(), 1, "a held map is not ranked again");
-    // An index past the candidates keeps the last one.
+    // Ties keep this frame's orientation with its turn allowance, and so does a
+    // measure that measures nothing.
     let mut state = CascadeState::default();
-    let past = ranked(&camera, &mut state, 1, 99, &offers);
-    assert_eq!(past.cascades[0], *offered.last().unwrap());
+    let tied = ranked(&camera, &mut state, 1, 99, &offers);
+    assert_eq!(tied, own);
+    for unmeasured in [f64::NAN, f64::INFINITY] {
+        let mut state = CascadeState::default();
+        let measure = |_: &Cascade| unmeasured;
+        let set = CascadeSet::fit_with_state_ranked(
+            &camera,
+            LIGHT,
+            &splits(1),
+            &options(),
+            &mut state,
+            &measure,
+        )
+        .unwrap();
+        assert_eq!(set, own);
+    }
 }
 
 #[test]

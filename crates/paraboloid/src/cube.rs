@@ -211,57 +211,60 @@ impl CubeOrientation {
     /// stores it.
     fn turn_corner_up(relative: &[DVec3]) -> Quat {
         let stand = DQuat::from_rotation_arc(DVec3::ONE.normalize(), DVec3::Y);
-        let level = |v: DVec3| DVec3::new(v.x, 0.0, v.z).normalize_or_zero();
-        let centre = relative.iter().fold(DVec3::ZERO, |a, v| a + *v);
-        let toward = level(centre);
+        let Some(toward) = level_toward(relative) else {
+            return rounded_turn(stand);
+        };
         // The lower faces' normals, a third of a turn apart about the diagonal.
+        let level = |v: DVec3| DVec3::new(v.x, 0.0, v.z).normalize_or_zero();
         let lower = [DVec3::NEG_X, DVec3::NEG_Y, DVec3::NEG_Z].map(|n| level(stand * n));
         let nearest = lower
             .into_iter()
             .max_by(|a, b| a.dot(toward).total_cmp(&b.dot(toward)))
             .unwrap_or(DVec3::X);
-        let turn = if toward == DVec3::ZERO {
-            stand
-        } else {
-            DQuat::from_rotation_arc(nearest, toward) * stand
-        };
-        let turn = turn.as_quat().normalize();
-        if turn.is_finite() {
-            turn
-        } else {
-            Quat::IDENTITY
-        }
+        rounded_turn(DQuat::from_rotation_arc(nearest, toward) * stand)
     }
 
     /// The turn of [`TowardReceivers`](Self::TowardReceivers) (world from cube) for
     /// the visible receivers' vertices given relative to the light, rounded to `f32`
     /// as the map stores it.
     fn turn_toward(relative: &[DVec3]) -> Quat {
-        if relative.is_empty() {
+        let Some(toward) = level_toward(relative) else {
             return Quat::IDENTITY;
-        }
-        let sum = relative.iter().fold(DVec3::ZERO, |a, v| a + *v);
-        let scale = relative
-            .iter()
-            .fold(0.0_f64, |a, v| a.max(v.abs().max_element()));
-        let centre = sum / relative.len() as f64;
-        let level = DVec3::new(centre.x, 0.0, centre.z);
-        let length = level.length();
-        if !(length > 1e-6 * scale) {
-            return Quat::IDENTITY;
-        }
-        let toward = level / length;
+        };
         let side = if toward.x.abs() >= toward.z.abs() {
             DVec3::new(toward.x.signum(), 0.0, 0.0)
         } else {
             DVec3::new(0.0, 0.0, toward.z.signum())
         };
-        let turn = DQuat::from_rotation_arc(side, toward).as_quat().normalize();
-        if turn.is_finite() {
-            turn
-        } else {
-            Quat::IDENTITY
-        }
+        rounded_turn(DQuat::from_rotation_arc(side, toward))
+    }
+}
+
+/// The level (XZ) unit direction from the light toward the centre of the
+/// receivers' vertices `relative` to it; `None` where there are none or the
+/// centre stands (nearly) straight above or below the light.
+fn level_toward(relative: &[DVec3]) -> Option<DVec3> {
+    if relative.is_empty() {
+        return None;
+    }
+    let sum = relative.iter().fold(DVec3::ZERO, |a, v| a + *v);
+    let scale = relative
+        .iter()
+        .fold(0.0_f64, |a, v| a.max(v.abs().max_element()));
+    let centre = sum / relative.len() as f64;
+    let level = DVec3::new(centre.x, 0.0, centre.z);
+    let length = level.length();
+    (length > 1e-6 * scale).then(|| level / length)
+}
+
+/// `turn` rounded to `f32` as a map stores it, or the identity where that is not
+/// finite.
+fn rounded_turn(turn: DQuat) -> Quat {
+    let turn = turn.as_quat().normalize();
+    if turn.is_finite() {
+        turn
+    } else {
+        Quat::IDENTITY
     }
 }
 
