@@ -7,8 +7,8 @@
 use arbitrary::Unstructured;
 use glam::{Mat4, Vec3};
 use shadowmap_frustum::{
-    Aabb, Camera, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState, ConvexBody,
-    DepthBounds, Frustum, Light, SceneBounds, SplitScheme, ValidCamera,
+    Aabb, Camera, Cascade, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState,
+    ConvexBody, DepthBounds, Frustum, Light, SceneBounds, SplitScheme, ValidCamera,
     directional_light_from_world, fit_spot,
 };
 
@@ -255,7 +255,10 @@ fn check_cascade_set(set: &CascadeSet) {
 /// The fit with a held state (`fit_with_state`, the stable fit's held sizes): the
 /// held depth range nests in the camera's, the sets it fits pass
 /// [`check_cascade_set`], and fitting the same frame again keeps every cascade's
-/// texel (a held map re-sized without cause would shimmer).
+/// texel (a held map re-sized without cause would shimmer). The same with a
+/// caller's measure (`fit_with_state_ranked`: each new map's orientation chosen
+/// and its turn allowance priced), measuring the map's area across the light,
+/// which prices the allowance at its whole growth.
 fn check_held_cascades(case: &CascadeCase, splits: &CascadeSplits, (near, far): (f32, f32)) {
     let mut state = CascadeState::new();
     let range = state.hold_depth_range(near, far, (near, far));
@@ -268,8 +271,30 @@ fn check_held_cascades(case: &CascadeCase, splits: &CascadeSplits, (near, far): 
     let Ok(valid) = ValidCamera::new(&case.camera) else {
         return;
     };
-    let mut fit =
-        || CascadeSet::fit_with_state(&valid, case.light, splits, &case.options, &mut state);
+    check_refit(|| {
+        CascadeSet::fit_with_state(&valid, case.light, splits, &case.options, &mut state)
+    });
+    let mut state = CascadeState::new();
+    let area = |c: &Cascade| {
+        let m = c.transform.uv_from_world;
+        let across = m.row(0).truncate().cross(m.row(1).truncate()).length();
+        1.0 / f64::from(across)
+    };
+    check_refit(|| {
+        CascadeSet::fit_with_state_ranked(
+            &valid,
+            case.light,
+            splits,
+            &case.options,
+            &mut state,
+            &area,
+        )
+    });
+}
+
+/// A held fit's first set passes [`check_cascade_set`], and the same frame fitted
+/// again keeps every cascade's texel.
+fn check_refit(mut fit: impl FnMut() -> Result<CascadeSet, shadowmap_frustum::FrustumError>) {
     let Ok(first) = fit() else {
         return;
     };
