@@ -224,9 +224,13 @@ pub fn fit_with_selector(
 pub struct FitState {
     /// `auto`'s current choice, kept with hysteresis.
     pub selector: TechniqueSelector,
-    /// The stable cascades' maps, of every count the count prediction fits (and
-    /// the stable and tight cascades' count), kept with hysteresis.
+    /// The stable cascades' maps, of every count the count prediction fits, and
+    /// their count, kept with hysteresis.
     pub cascades: CascadeState,
+    /// The tight cascades' count, kept with hysteresis (their maps are not held):
+    /// apart from the stable cascades', so that `auto`, which fits both each
+    /// frame, does not hand one's count to the other.
+    pub tight: CascadeState,
     /// The warped cascades' count, kept with hysteresis (their maps are not held).
     pub warped: CascadeState,
 }
@@ -296,9 +300,11 @@ fn fit_one(
         Technique::Lispsm(_) | Technique::Xpsm(_) | Technique::Tsm(_) => {
             (fit_warp(technique, direction, input)?, 1)
         }
-        Technique::StableCascades(plan) | Technique::TightCascades(plan) => {
-            let stable = matches!(technique, Technique::StableCascades(_));
-            fit_cascades(plan, stable, direction, input, &mut state.cascades)?
+        Technique::StableCascades(plan) => {
+            fit_cascades(plan, true, direction, input, &mut state.cascades)?
+        }
+        Technique::TightCascades(plan) => {
+            fit_cascades(plan, false, direction, input, &mut state.tight)?
         }
         Technique::WarpedCascades { plan, lispsm } => {
             fit_warped(plan, lispsm, direction, input, &mut state.warped)?

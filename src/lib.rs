@@ -101,7 +101,10 @@
 //! choice, the cascade counts (kept unless another is clearly better) and each stable
 //! cascade's map extents and orientation, fitted to slice ∩ receivers turned by up
 //! to [`STABLE_TURN`](frustum::STABLE_TURN) (or grown by
-//! [`STABLE_HEADROOM`](frustum::STABLE_HEADROOM) where that is more) and kept
+//! [`STABLE_HEADROOM`](frustum::STABLE_HEADROOM) where that is more; with the
+//! eye's samples, the headroom alone where the map with the turn would measure
+//! more than [`STABLE_MAX_OVER_TIGHT`](frustum::STABLE_MAX_OVER_TIGHT) times the
+//! tight box) and kept
 //! while they still cover the footprint and are at most
 //! [`STABLE_SHRINK_RATIO`](frustum::STABLE_SHRINK_RATIO) times too big, so the
 //! maps move by whole texels and shadow edges do not shimmer.
