@@ -359,6 +359,17 @@ fn turned_extent(points: &(impl Iterator<Item = DVec3> + Clone), light: &DMat4, 
     out
 }
 
+/// The light-space bounds (x, y) of `points` in the frame `light`.
+fn light_bounds(points: &(impl Iterator<Item = DVec3> + Clone), light: &DMat4) -> (DVec2, DVec2) {
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in points.clone() {
+        let q = light.transform_point3(p).truncate();
+        lo = lo.min(q);
+        hi = hi.max(q);
+    }
+    (lo, hi)
+}
+
 /// The light-space extents (x, y) of box `b` in the frame `light`.
 fn box_extent(b: &Aabb, light: &DMat4) -> DVec2 {
     let (lo, hi) = (b.min.as_dvec3(), b.max.as_dvec3());
@@ -534,6 +545,9 @@ impl Fit<'_> {
             }
         }
         let unturned = self.new_box(points, direction, best.1.up, false)?;
+        if unturned.1.side == best.1.side {
+            return Ok(best);
+        }
         let tight = self.tight(points, light_rotation(direction, own));
         // In the same frame an orthographic map's error grows at most as its
         // texels' sides: within the bound on both, it is within it on the measure.
@@ -543,7 +557,7 @@ impl Fit<'_> {
                 .side
                 .cmple((tight.hi - tight.lo) * STABLE_MAX_OVER_TIGHT)
                 .all();
-        if unturned.1.side == best.1.side || within {
+        if within {
             return Ok(best);
         }
         let best_error = best_error.unwrap_or_else(|| measure(&best.0));
@@ -558,12 +572,7 @@ impl Fit<'_> {
     /// The tight box over `points` in the frame `light`: their bounds, no margin,
     /// no snap.
     fn tight(&self, points: &(impl Iterator<Item = DVec3> + Clone), light: DMat4) -> HeldBox {
-        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        for p in points.clone() {
-            let q = light.transform_point3(p).truncate();
-            lo = lo.min(q);
-            hi = hi.max(q);
-        }
+        let (lo, hi) = light_bounds(points, &light);
         HeldBox {
             light_from_world: light,
             lo,
@@ -583,12 +592,7 @@ impl Fit<'_> {
         held: DVec2,
         turn: bool,
     ) -> Result<(HeldBox, DVec2, bool), FrustumError> {
-        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        for p in points.clone() {
-            let q = light.transform_point3(p).truncate();
-            lo = lo.min(q);
-            hi = hi.max(q);
-        }
+        let (lo, hi) = light_bounds(points, &light);
         let scale = lo.abs().max(hi.abs()).max_element();
         let needed = with_slack(hi - lo, scale, self.res)?;
         let turned = || {
