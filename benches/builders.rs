@@ -5,8 +5,11 @@
 //! the exact cone, RTW warp tables from a 1-D importance, and camera validation; the
 //! cascade fits and the four single-frustum warps also from a camera validated once
 //! per frame (`ValidCamera`), and the focus body alone with each warp fitted from a
-//! body built once (`FocusBody`: what a frame pays per technique once the body is
-//! shared), and the 4-cascade fits refitted in place into a set kept across calls
+//! body built once (`FocusBody`: what a frame pays per technique once the body and
+//! its probe points, cast by the first warp fitted from it, are shared), LiSPSM from
+//! a body built in the call (`lispsm_valid`: a frame with one warped light), the IPSM
+//! plan from the validated camera (`ipsm_plan_exact_cone_valid`), and the
+//! 4-cascade fits refitted in place into a set kept across calls
 //! (`CascadeSet::refit_valid`), and the held stable fit (`CascadeSet::fit_with_state`,
 //! maps fitted to slice ∩ receivers with their sizes kept in a state across calls).
 //! Besides criterion's figures it prints one table: each
@@ -130,7 +133,7 @@ struct Outputs {
 }
 
 /// The builders, by name.
-const NAMES: [&str; 24] = [
+const NAMES: [&str; 26] = [
     "bevy_cascades_4",
     "uniform_focused",
     "stable_cascades_4",
@@ -155,6 +158,8 @@ const NAMES: [&str; 24] = [
     "stable_cascades_4_refit",
     "tight_cascades_4_refit",
     "stable_cascades_4_held",
+    "lispsm_valid",
+    "ipsm_plan_exact_cone_valid",
 ];
 
 /// Keeps a builder's result where it was returned (the output is not moved out of
@@ -275,6 +280,21 @@ fn run(f: &Frame, out: &mut Outputs, which: usize) {
             let fitted =
                 CascadeSet::fit_with_state(&f.valid, light, &f.splits, &options, &mut out.held);
             keep(&fitted);
+        }
+        24 => {
+            // One warp a frame from a camera validated once: the body, its probe
+            // and the fit (what an engine with one LiSPSM light pays).
+            let body = FocusBody::new_valid(black_box(&f.valid), light, &f.scene);
+            keep(&body.as_ref().unwrap().lispsm(&LispsmOptions::default()));
+        }
+        25 => {
+            let o = IpsmOptions::default().with_fit(ConeFit::Exact);
+            keep(&IpsmPlan::new_valid(
+                black_box(&f.point),
+                black_box(&f.valid),
+                Some(f.bounds),
+                &o,
+            ));
         }
         _ => unreachable!("no builder {which}"),
     }

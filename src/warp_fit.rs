@@ -36,28 +36,30 @@ pub(crate) fn fit_warp(
     input: &FitInput<'_>,
 ) -> Result<Fitted, FitError> {
     let (camera, scene) = (input.camera, &input.scene);
-    // One focus body for every strength tried. Where it fails, the warp's own entry
-    // point reports the error it reports (an invalid option before the body's).
-    let body = FocusBody::new(camera, direction, scene).ok();
+    // One focus body for every strength tried, with its probe points cast once (it
+    // is read where it was built: a body is large). Where it fails, the warp's own
+    // entry point reports the error it reports (an invalid option before the body's).
+    let built = FocusBody::new(camera, direction, scene);
+    let body = built.as_ref().ok();
     let fit_at = |scale: f32| -> Result<Fitted, FitError> {
         Ok(match technique {
             Technique::Lispsm(o) => {
                 let o = o.with_strength_scale(o.strength_scale * scale);
-                Fitted::Lispsm(match &body {
+                Fitted::Lispsm(match body {
                     Some(body) => body.lispsm(&o)?,
                     None => lispsm(camera, direction, scene, &o)?,
                 })
             }
             Technique::Xpsm(o) => {
                 let o = o.with_strength_scale(o.strength_scale * scale);
-                Fitted::Xpsm(match &body {
+                Fitted::Xpsm(match body {
                     Some(body) => body.xpsm(&o)?,
                     None => xpsm(camera, direction, scene, &o)?,
                 })
             }
             Technique::Tsm(o) => {
                 let o = o.with_strength_scale(o.strength_scale * scale);
-                Fitted::Tsm(match &body {
+                Fitted::Tsm(match body {
                     Some(body) => body.tsm(&o)?,
                     None => tsm(camera, direction, scene, &o)?,
                 })

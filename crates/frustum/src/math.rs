@@ -140,6 +140,7 @@ pub fn acos_clamped(x: f64) -> f64 {
 ///
 /// Infinite or NaN where `s` is 0 or undefined (a singular or non-finite matrix).
 #[must_use]
+#[inline]
 pub fn inverse_square_smaller_singular_value(a: glam::DVec2, b: glam::DVec2) -> f64 {
     let frobenius = a.length_squared() + b.length_squared();
     let det = a.perp_dot(b);

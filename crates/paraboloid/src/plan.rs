@@ -151,6 +151,19 @@ pub struct IpsmPlan {
     pub depth_range: (f32, f32),
 }
 
+/// The position and range of a checked point or spot light (a spot is planned as
+/// a point light at its position).
+fn point_light(light: &Light) -> Result<(Vec3, f32), ParaboloidError> {
+    light.validate()?;
+    match *light {
+        Light::Point { position, range }
+        | Light::Spot {
+            position, range, ..
+        } => Ok((position, range)),
+        Light::Directional { .. } => Err(ParaboloidError::UnsupportedLight),
+    }
+}
+
 impl IpsmPlan {
     /// Plans the paraboloid map of a point or spot light for `camera`, truncated to the
     /// measured `bounds` (or the camera's whole depth range when `None`; bounds are
@@ -181,16 +194,63 @@ impl IpsmPlan {
         bounds: Option<DepthBounds>,
         options: &IpsmOptions,
     ) -> Result<Self, ParaboloidError> {
-        light.validate()?;
-        let (position, range) = match *light {
-            Light::Point { position, range }
-            | Light::Spot {
-                position, range, ..
-            } => (position, range),
-            Light::Directional { .. } => return Err(ParaboloidError::UnsupportedLight),
-        };
-        // Checked once; the depth range and the slice below reuse it.
-        let valid = ValidCamera::new_validated(camera)?;
+        let (position, range) = point_light(light)?;
+        // Checked once; the depth range and the slice reuse it.
+        Self::plan_valid(
+            position,
+            range,
+            &ValidCamera::new_validated(camera)?,
+            bounds,
+            options,
+        )
+    }
+
+    /// [`IpsmPlan::new`] for a camera checked once per frame ([`ValidCamera`]), as
+    /// the cascades take it: what a frame that plans several lights, or refits
+    /// other techniques for the same view, pays per light.
+    ///
+    /// # Errors
+    /// As [`IpsmPlan::new`], without the camera's.
+    ///
+    /// ```
+    /// use glam::Vec3;
+    /// use shadowmap_frustum::{Camera, Light, Projection, ValidCamera};
+    /// use shadowmap_paraboloid::{IpsmOptions, IpsmPlan};
+    ///
+    /// let camera = Camera::look_to(
+    ///     Vec3::new(0.0, 1.7, 0.0),
+    ///     Vec3::NEG_Z,
+    ///     Vec3::Y,
+    ///     Projection::perspective(1.0, 1.6, 0.1, 60.0),
+    /// )?;
+    /// let valid = ValidCamera::new(&camera)?;
+    /// let lamp = Light::Point { position: Vec3::new(2.0, 3.0, -8.0), range: 40.0 };
+    /// let plan = IpsmPlan::new_valid(&lamp, &valid, None, &IpsmOptions::default())?;
+    /// assert_eq!(
+    ///     plan,
+    ///     IpsmPlan::new(&lamp, &camera, None, &IpsmOptions::default())?
+    /// );
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn new_valid(
+        light: &Light,
+        camera: &ValidCamera,
+        bounds: Option<DepthBounds>,
+        options: &IpsmOptions,
+    ) -> Result<Self, ParaboloidError> {
+        let (position, range) = point_light(light)?;
+        Self::plan_valid(position, range, camera, bounds, options)
+    }
+
+    /// The plan of a point light at `position` with `range` for a checked camera
+    /// (the light checked by [`point_light`]).
+    fn plan_valid(
+        position: Vec3,
+        range: f32,
+        valid: &ValidCamera,
+        bounds: Option<DepthBounds>,
+        options: &IpsmOptions,
+    ) -> Result<Self, ParaboloidError> {
         let (lo, hi) = match bounds {
             Some(b) if b.min.is_nan() || b.max.is_nan() => return Err(ParaboloidError::NonFinite),
             Some(b) if b.min > b.max => {
@@ -199,11 +259,12 @@ impl IpsmPlan {
                     max: b.max,
                 });
             }
-            Some(b) => b.clamped_to_valid(&valid),
+            Some(b) => b.clamped_to_valid(valid),
             None => valid.depth_range(),
         };
         let corners = valid.slice_corners(lo, hi)?;
-        let mut plan = Self::from_points(position, range, &corners, camera.forward(), options)?;
+        let forward = valid.camera().forward();
+        let mut plan = Self::from_points(position, range, &corners, forward, options)?;
         plan.depth_range = (lo, hi);
         Ok(plan)
     }

@@ -1,12 +1,13 @@
 //! The per-frame path allocates nothing: the IPSM plan with both cone fits (single
-//! cut maps and dual fallbacks), the cone fits alone and the map's lookups, under a
+//! cut maps and dual fallbacks; from a camera and from a `ValidCamera`, the same
+//! plan), the cone fits alone and the map's lookups, under a
 //! counting global allocator (one test in this binary, so nothing else allocates
 //! meanwhile).
 
 use std::alloc::System;
 
 use glam::Vec3;
-use shadowmap_frustum::{Camera, DepthBounds, Light, Projection, ShadowMapping};
+use shadowmap_frustum::{Camera, DepthBounds, Light, Projection, ShadowMapping, ValidCamera};
 use shadowmap_paraboloid::{ConeFit, IpsmOptions, IpsmPlan, fit_minimal_cone, fit_paper_cone};
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
 
@@ -28,6 +29,7 @@ fn per_frame_path_does_not_allocate() {
     };
     let exact = IpsmOptions::default();
     let paper = IpsmOptions::default().with_fit(ConeFit::Paper);
+    let valid = ValidCamera::new(&camera).unwrap();
 
     let region = Region::new(GLOBAL);
     let (mut singles, mut duals) = (0, 0);
@@ -46,6 +48,8 @@ fn per_frame_path_does_not_allocate() {
         };
         for options in [&exact, &paper] {
             let plan = IpsmPlan::new(&light, &camera, Some(bounds), options).unwrap();
+            let from_valid = IpsmPlan::new_valid(&light, &valid, Some(bounds), options);
+            assert!(from_valid == Ok(plan));
             if plan.is_single() {
                 singles += 1;
             } else {

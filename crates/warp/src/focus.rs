@@ -2,6 +2,7 @@
 //! focus body (frustum ∩ receivers, extruded toward the light for the casters).
 
 use arrayvec::ArrayVec;
+use core::cell::{Ref, RefCell};
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
 use shadowmap_frustum::{
     Aabb, Camera, ConvexBody, Frustum, LightDirection, LightPrism, MAX_BODY_VERTICES,
@@ -9,6 +10,7 @@ use shadowmap_frustum::{
 };
 
 use crate::WarpError;
+use crate::predict::Probe;
 
 /// Largest warp ratio `1 + s d` (near-to-far texel scale along the warp axis) a
 /// LiSPSM, TSM or XPSM fit uses; stronger warps are clamped to it so `f32` matrices
@@ -169,7 +171,14 @@ pub(crate) fn light_unit(direction: Vec3) -> Result<DVec3, WarpError> {
 /// up term full weight far from the view axis cancels where the warps are strong,
 /// and points the warp backward on one side of that point.)
 pub(crate) fn frame(light: DVec3, forward: DVec3, cam_up: DVec3) -> (DMat4, f64) {
+    let (rot, sin_g, _) = frame_and_axis(light, forward, cam_up);
+    (rot, sin_g)
+}
+
+/// [`frame`] and the length of its raw axis ([`frame_axis`]).
+fn frame_and_axis(light: DVec3, forward: DVec3, cam_up: DVec3) -> (DMat4, f64, f64) {
     let (up, sin_g) = frame_axis(light, forward, cam_up);
+    let axis_length = up.length();
     let up = up.try_normalize().unwrap_or_else(|| {
         // Only on the two (measure-zero) directions where the blend cancels: any
         // axis perpendicular to the light keeps the frame valid.
@@ -184,7 +193,7 @@ pub(crate) fn frame(light: DVec3, forward: DVec3, cam_up: DVec3) -> (DMat4, f64)
         DVec4::new(x.z, y.z, z.z, 0.0),
         DVec4::W,
     );
-    (rot, sin_g)
+    (rot, sin_g, axis_length)
 }
 
 /// The warp axis of [`frame`] before it is normalized, `a = g + c(|g|) u` made
@@ -243,8 +252,11 @@ pub(crate) struct Focus {
     pub(crate) caster_scale: f64,
     pub(crate) light_caster_scale: f64,
     pub(crate) receiver_scale: f64,
-    /// ... and how far the receivers' footprint is from thin ([`footprint_weight`]).
+    /// ... how far the receivers' footprint is from thin ([`footprint_weight`]) ...
     pub(crate) wide: f64,
+    /// ... and how far the fitted boxes are widened toward turn-invariance near the
+    /// light frame's two zeros (see `turn_invariant`).
+    pub(crate) turn_weight: f64,
 }
 
 impl Focus {
@@ -264,7 +276,7 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
     if body.is_empty() {
         return Err(WarpError::NoVisibleReceivers);
     }
-    let (rot, sin_gamma) = frame(dir, view.forward, view.up);
+    let (rot, sin_gamma, axis_length) = frame_and_axis(dir, view.forward, view.up);
     let receivers: ReceiverPoints = body.iter().map(|v| v.as_dvec3()).collect();
     // The receivers' light-space bounds: the caster prism's and the footprint's.
     let mut footprint = Bounds::EMPTY;
@@ -284,12 +296,14 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
     }
     let receiver_scale = scale_of(&receivers);
     Ok(FocusBody {
+        probe: RefCell::new(Probe::new()),
         view,
         focus: Focus {
             light: dir,
             rot,
             sin_gamma,
             wide: footprint_weight(&footprint, receiver_scale),
+            turn_weight: crate::lispsm::turn_invariant_weight(axis_length),
             caster_scale: scale_of(&casters),
             light_caster_scale,
             receiver_scale,
@@ -309,6 +323,11 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
 /// Build it with [`FocusBody::new`], then fit any number of techniques from it
 /// ([`FocusBody::uniform`], [`FocusBody::lispsm`], [`FocusBody::xpsm`],
 /// [`FocusBody::tsm`]) without repeating the validation, the clipping or the frame.
+/// The warps choose their strengths on the predicted aliasing error at probe points
+/// of the body (most of a warp's time); the body fills those points when the first
+/// warp needs them and keeps them, so LiSPSM, XPSM and TSM from one body (or one
+/// warp at several strength scales) cast the probe rays once. That cache makes a
+/// body `Send` but not `Sync`: fit from one thread, or clone it per thread.
 /// The free functions ([`uniform_focused`](crate::uniform_focused),
 /// [`lispsm`](crate::lispsm), ...) build one and call these.
 ///
@@ -337,9 +356,22 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
 pub struct FocusBody {
     pub(crate) view: View,
     pub(crate) focus: Focus,
+    /// The error prediction's probe points, filled by the first warp that needs them.
+    probe: RefCell<Probe>,
 }
 
 impl FocusBody {
+    /// The probe points the warps choose their strengths on, cast on first use.
+    pub(crate) fn probe(&self) -> Ref<'_, Probe> {
+        if !self.probe.borrow().is_filled() {
+            // Filled where it lives: a probe is too large to build and move. No
+            // borrow is held here (a probe is only read while a warp chooses its
+            // strength, and filled before), so the mutable borrow cannot fail.
+            self.probe.borrow_mut().fill(&self.view, &self.focus);
+        }
+        self.probe.borrow()
+    }
+
     /// The focus body of a camera's whole frustum.
     ///
     /// # Errors

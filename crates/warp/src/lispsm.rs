@@ -4,10 +4,7 @@ use glam::{DMat4, DVec4, Vec3};
 use shadowmap_frustum::{Camera, ShadowTransform, math};
 
 use crate::WarpError;
-use crate::focus::{
-    Bounds, Focus, FocusBody, View, finish, frame_axis, ortho_fit, smoothstep, sqrt0,
-};
-use crate::predict::Probe;
+use crate::focus::{Bounds, Focus, FocusBody, View, finish, ortho_fit, smoothstep, sqrt0};
 use crate::{MAX_WARP_RATIO, ParallelFade, SceneBounds};
 
 /// Options of [`lispsm`].
@@ -171,8 +168,7 @@ impl FocusBody {
     pub fn lispsm(&self, options: &LispsmOptions) -> Result<LispsmShadow, WarpError> {
         options.check()?;
         let (s, fade) = warp_strength(&self.focus, &self.view, options);
-        let s = chosen_strength(&self.focus, &self.view, s, options.strength_scale);
-        let (transform, s) = warp_fit(&self.focus, &self.view, s, options.reversed_z)?;
+        let (transform, s) = fit_chosen(self, s, options.strength_scale, options.reversed_z)?;
         Ok(LispsmShadow {
             transform,
             n: if s > 0.0 {
@@ -302,11 +298,12 @@ pub(crate) fn warp_clip(
     if b.is_empty() || !(b.min.is_finite() && b.max.is_finite()) {
         return Err(WarpError::Degenerate);
     }
-    let b = turn_invariant(b, f, view, &warp_from_world).padded(scale, 1.0 - wide);
+    let b = turn_invariant(b, f, &warp_from_world).padded(scale, 1.0 - wide);
     Ok((ortho_fit(&b, reversed_z) * warp_from_world, s, scale))
 }
 
-/// Length of the light frame's raw axis ([`frame_axis`]) below which the box of a
+/// Length of the light frame's raw axis
+/// ([`frame_axis`](crate::focus::frame_axis)) below which the box of a
 /// fit is fully turn-invariant, and above which it is the plain box (see
 /// [`turn_invariant`]); radians, for small ones.
 const TURN_INVARIANT_BAND: (f64, f64) = (0.01, 0.02);
@@ -325,14 +322,8 @@ const TURN_INVARIANT_BAND: (f64, f64) = (0.01, 0.02);
 /// texel size continuous there (the matrices still turn: no frame can avoid that).
 /// Every warp has faded to the uniform fit there, and the box is at most `sqrt 2`
 /// times larger, only within about a degree of one direction.
-pub(crate) fn turn_invariant(
-    mut b: Bounds,
-    f: &Focus,
-    view: &View,
-    warp_from_world: &DMat4,
-) -> Bounds {
-    let (axis, _) = frame_axis(f.light, view.forward, view.up);
-    let w = 1.0 - smoothstep(TURN_INVARIANT_BAND.0, TURN_INVARIANT_BAND.1, axis.length());
+pub(crate) fn turn_invariant(mut b: Bounds, f: &Focus, warp_from_world: &DMat4) -> Bounds {
+    let w = f.turn_weight;
     if !(w > 0.0) {
         return b;
     }
@@ -353,6 +344,14 @@ pub(crate) fn turn_invariant(
     b
 }
 
+/// The weight of [`turn_invariant`]'s widening (once per focus body) for a light
+/// frame whose raw axis ([`frame_axis`](crate::focus::frame_axis)) is
+/// `axis_length` long: 1 within the first bound of [`TURN_INVARIANT_BAND`], 0
+/// beyond the second, smooth between.
+pub(crate) fn turn_invariant_weight(axis_length: f64) -> f64 {
+    1.0 - smoothstep(TURN_INVARIANT_BAND.0, TURN_INVARIANT_BAND.1, axis_length)
+}
+
 /// The strength `s` with its warp ratio `1 + s d` raised to `scale` (`d` the focus
 /// body's extent along the warp axis; see `strength_scale` of the options): 1 keeps
 /// it, 0 is the uniform fit.
@@ -361,29 +360,76 @@ pub(crate) fn scaled_strength(f: &Focus, s: f64, scale: f32) -> f64 {
     crate::xpsm::faded_length(s, (y1 - y0).max(0.0), f64::from(scale))
 }
 
-/// The strength a warp fits at: [`predicted_strength`] for its formula's `s_formula`,
-/// scaled by `scale` ([`scaled_strength`]). At `scale` 0 that is the uniform fit
-/// whatever the prediction, so the prediction (most of a warp's cost) is skipped.
-pub(crate) fn chosen_strength(f: &Focus, view: &View, s_formula: f64, scale: f32) -> f64 {
-    if scale <= 0.0 {
-        return 0.0;
+/// The fit of `body` at its chosen strength ([`chosen_strength`]) and the `s` used:
+/// the prediction's own fit at that strength where it made one (the chosen
+/// strength is one of its grid's, unscaled), else [`warp_fit`] again.
+pub(crate) fn fit_chosen(
+    body: &FocusBody,
+    s_formula: f64,
+    scale: f32,
+    reversed_z: bool,
+) -> Result<(ShadowTransform, f64), WarpError> {
+    let (f, view) = (&body.focus, &body.view);
+    match chosen_strength(body, s_formula, scale, reversed_z) {
+        Chosen {
+            fitted: Some((clip, s, world_scale)),
+            ..
+        } => finish(f.rot, clip, reversed_z, f.light, world_scale).map(|t| (t, s)),
+        Chosen { s, .. } => warp_fit(f, view, s, reversed_z),
     }
-    scaled_strength(f, predicted_strength(f, view, s_formula), scale)
+}
+
+/// A warp's chosen strength `s`, and [`warp_clip`]'s fit at it where the
+/// prediction made it.
+struct Chosen {
+    s: f64,
+    fitted: Option<(DMat4, f64, f64)>,
+}
+
+/// The strength a warp of `body` fits at: [`predicted_strength`] for its formula's
+/// `s_formula`, scaled by `scale` ([`scaled_strength`]). At `scale` 0 that is the
+/// uniform fit whatever the prediction, so the prediction (most of a warp's cost) is
+/// skipped.
+fn chosen_strength(body: &FocusBody, s_formula: f64, scale: f32, reversed_z: bool) -> Chosen {
+    if scale <= 0.0 {
+        return Chosen {
+            s: 0.0,
+            fitted: None,
+        };
+    }
+    let (s, fitted) = predicted_strength(body, s_formula, reversed_z);
+    // A scale of 1 keeps `s` exactly (`scaled_strength`), and the prediction's fit
+    // with it.
+    if scale >= 1.0 {
+        Chosen { s, fitted }
+    } else {
+        Chosen {
+            s: scaled_strength(&body.focus, s, scale),
+            fitted: None,
+        }
+    }
 }
 
 /// The strength to use for a warp whose formula asks for `s_formula`: the fraction
-/// of its warp ratio, `ln(1 + s d)`, of least predicted error (see
-/// [`Probe::strength`]), so that the fit degrades continuously to the uniform fit
-/// where the formula's warp does not pay.
-fn predicted_strength(f: &Focus, view: &View, s_formula: f64) -> f64 {
+/// of its warp ratio, `ln(1 + s d)`, of least predicted error on the body's probe
+/// (see [`Probe::strength`](crate::predict)), so that the fit degrades continuously
+/// to the uniform fit where the formula's warp does not pay; and [`warp_clip`]'s fit
+/// at it (depth as `reversed_z` asks: the prediction reads only the clip's `x`, `y`
+/// and `w`) where the prediction made it.
+fn predicted_strength(
+    body: &FocusBody,
+    s_formula: f64,
+    reversed_z: bool,
+) -> (f64, Option<(DMat4, f64, f64)>) {
     if !(s_formula > 0.0) {
-        return 0.0;
+        return (0.0, None);
     }
+    let (f, view) = (&body.focus, &body.view);
     let (y0, y1) = f.warp_axis_range();
     let d = (y1 - y0).max(0.0);
     let ln_r = ln_1p(s_formula * d);
     if !(d > 0.0 && ln_r.is_finite() && ln_r > 0.0) {
-        return s_formula;
+        return (s_formula, None);
     }
     let s_at = |t: f64| {
         if t >= 1.0 {
@@ -392,14 +438,11 @@ fn predicted_strength(f: &Focus, view: &View, s_formula: f64) -> f64 {
             (math::exp(t * ln_r) - 1.0) / d
         }
     };
-    let mut probe = Probe::new();
-    probe.fill(view, f);
-    let t = probe.strength(|t| {
-        warp_clip(f, view, s_at(t), false)
-            .ok()
-            .map(|(clip, _, _)| clip)
-    });
-    s_at(t)
+    let (t, fitted) = body.probe().strength(
+        |t| warp_clip(f, view, s_at(t), reversed_z).ok(),
+        |fit| &fit.0,
+    );
+    (s_at(t), fitted)
 }
 
 #[cfg(test)]
@@ -619,6 +662,34 @@ pub(crate) mod tests {
         );
     }
 
+    /// The prediction's own fit at the chosen strength, which the warp keeps
+    /// instead of fitting again, is the fit `warp_clip` makes at that strength (in
+    /// either depth convention: the prediction reads only clip `x`, `y` and `w`).
+    #[test]
+    fn the_predictions_fit_is_the_fit_at_the_chosen_strength() {
+        let (_, camera, scene) = overhead_view();
+        let mut kept = 0;
+        for light in [
+            Vec3::new(0.3, -1.0, 0.6),
+            Vec3::new(0.0, -0.3, -1.0),
+            Vec3::new(1.0, -0.2, 0.1),
+        ] {
+            let body = FocusBody::new(&camera, light, &scene).unwrap();
+            for reversed_z in [false, true] {
+                let o = LispsmOptions::default().with_reversed_z(reversed_z);
+                let (s, _) = warp_strength(&body.focus, &body.view, &o);
+                let chosen = chosen_strength(&body, s, 1.0, reversed_z);
+                let Some(fitted) = chosen.fitted else {
+                    continue;
+                };
+                let fresh = warp_clip(&body.focus, &body.view, chosen.s, reversed_z).unwrap();
+                assert_eq!(fitted, fresh, "{light} {reversed_z}");
+                kept += 1;
+            }
+        }
+        assert!(kept >= 2, "{kept}");
+    }
+
     /// At scale 0 every strength scales to the uniform fit's, exactly: what lets
     /// `chosen_strength` skip the prediction there.
     #[test]
@@ -635,7 +706,7 @@ pub(crate) mod tests {
             }
             let o = LispsmOptions::default();
             let (s, _) = warp_strength(&body.focus, &body.view, &o);
-            assert_eq!(chosen_strength(&body.focus, &body.view, s, 0.0), 0.0);
+            assert_eq!(chosen_strength(&body, s, 0.0, false).s, 0.0);
         }
     }
 

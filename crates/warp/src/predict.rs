@@ -57,7 +57,7 @@ const _: () = assert!(DEPTHS == 4);
 /// Exponent of the power mean over the probe points (between a mean and a maximum,
 /// close to the high percentiles by which the quality report ranks techniques).
 const POWER: i32 = 8;
-// `Probe::error` raises `1 / s²` to the fourth power.
+// `points_error` raises `1 / s²` to the fourth power.
 const _: () = assert!(POWER == 8);
 /// Smallest weight of a ray that meets the box.
 const RAY_WEIGHT_FLOOR: f64 = 1e-3;
@@ -99,22 +99,72 @@ struct Ray {
 /// Most probe points of a focus body.
 const MAX_POINTS: usize = COLUMNS * ROWS * DEPTHS;
 
-/// The probe points of a focus body, twice: `points` with the normals of the
-/// receivers' box faces they lie on, weighted by how front-lit those faces are, and
-/// `perspective` at the same places facing the bisector of the eye and light
-/// directions, at their whole weight (the error of the parameterization alone,
-/// which needs no lit surface). The second set is needed only where few faces are
-/// front-lit ([`Probe::confidence`] below 1), so it is filled on first use from the
-/// rays kept in `rays`.
+/// Probe points stored by coordinate (one array per component of [`Point`]), so
+/// that [`points_error`]'s loop runs on several points at once (SIMD lanes), which
+/// an array of points does not let the compiler do.
+#[derive(Clone, Debug, Default)]
+struct ProbePoints {
+    p: [ArrayVec<f64, MAX_POINTS>; 3],
+    dx: [ArrayVec<f64, MAX_POINTS>; 3],
+    dy: [ArrayVec<f64, MAX_POINTS>; 3],
+    weight: ArrayVec<f64, MAX_POINTS>,
+    fade: ArrayVec<f64, MAX_POINTS>,
+}
+
+impl ProbePoints {
+    fn new() -> Self {
+        Self {
+            p: [ArrayVec::new(), ArrayVec::new(), ArrayVec::new()],
+            dx: [ArrayVec::new(), ArrayVec::new(), ArrayVec::new()],
+            dy: [ArrayVec::new(), ArrayVec::new(), ArrayVec::new()],
+            weight: ArrayVec::new(),
+            fade: ArrayVec::new(),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.weight.len()
+    }
+
+    fn clear(&mut self) {
+        for column in self.p.iter_mut().chain(&mut self.dx).chain(&mut self.dy) {
+            column.clear();
+        }
+        self.weight.clear();
+        self.fade.clear();
+    }
+
+    /// Adds `q` unless the set is full.
+    fn push(&mut self, q: &Point) {
+        if self.weight.is_full() {
+            return;
+        }
+        for axis in 0..3 {
+            self.p[axis].push(q.p[axis]);
+            self.dx[axis].push(q.dx[axis]);
+            self.dy[axis].push(q.dy[axis]);
+        }
+        self.weight.push(q.weight);
+        self.fade.push(q.fade);
+    }
+}
+
+/// The probe points of a focus body: `points` with the normals of the receivers'
+/// box faces they lie on, weighted by how front-lit those faces are. Where few
+/// faces are front-lit ([`Probe::confidence`] below 1) the same places facing the
+/// bisector of the eye and light directions, at their whole weight (the error of
+/// the parameterization alone, which needs no lit surface), are cast again from the
+/// rays kept in `rays` when a strength is chosen.
+///
+/// The probe depends on the body alone (its view, receivers and light), so a
+/// [`FocusBody`](crate::FocusBody) fills it once and every warp fitted from that
+/// body chooses its strength on the same points.
 #[derive(Clone, Debug)]
 pub(crate) struct Probe {
-    points: ArrayVec<Point, MAX_POINTS>,
-    perspective: ArrayVec<Point, MAX_POINTS>,
-    /// Whether `perspective` holds its points.
-    perspective_filled: bool,
+    points: ProbePoints,
     /// The weight the points would carry if every surface were front-lit.
     geometric: f64,
-    /// What the rays were cast from, for the `perspective` pass.
+    /// What the rays were cast from, for the perspective pass.
     rays: Option<Rays>,
 }
 
@@ -129,18 +179,28 @@ struct Rays {
 }
 
 impl Rays {
-    /// Adds the points of `pass` of every ray to `out`; returns the sum of the rays'
-    /// weights.
-    fn cast(&self, pass: Pass, out: &mut ArrayVec<Point, MAX_POINTS>) -> f64 {
-        let mut geometric = 0.0;
+    /// Adds the points of `pass` of every ray to `out`, row by row; returns the sum
+    /// of the rays' weights.
+    fn cast(&self, pass: Pass, out: &mut ProbePoints) -> f64 {
+        let columns: [Column; COLUMNS] = core::array::from_fn(|column| {
+            self.screen.column((column as f64 + 0.5) / COLUMNS as f64)
+        });
+        // Every ray's segment first: the rays are independent, so their chains of
+        // divisions overlap, where one ray's points after another's would wait on
+        // each in turn.
+        let mut segments: ArrayVec<(Ray, Segment), { COLUMNS * ROWS }> = ArrayVec::new();
         for row in 0..ROWS {
-            for column in 0..COLUMNS {
-                let at = DVec2::new(
-                    (column as f64 + 0.5) / COLUMNS as f64,
-                    (row as f64 + 0.5) / ROWS as f64,
-                );
-                geometric += ray_points(self, at, pass, out);
+            let y = (row as f64 + 0.5) / ROWS as f64;
+            for column in &columns {
+                let ray = column.ray(y);
+                if let Some(segment) = Segment::new(&ray, &self.screen, &self.receivers) {
+                    segments.push((ray, segment));
+                }
             }
+        }
+        let mut geometric = 0.0;
+        for (ray, segment) in &segments {
+            geometric += ray_points(self, ray, segment, pass, out);
         }
         geometric
     }
@@ -167,19 +227,27 @@ struct Screen {
 impl Screen {
     /// The ray through `(x, y)`: the bilinear interpolation of the near and of the
     /// far face's corners, and its exact derivatives in `x` and `y`.
+    #[cfg(test)]
     fn ray(&self, x: f64, y: f64) -> Ray {
+        self.column(x).ray(y)
+    }
+
+    /// What the rays at screen `x` share: each face's points at `x` on its bottom
+    /// and top edges.
+    fn column(&self, x: f64) -> Column {
         let at = |q: &[DVec3; 4]| {
             let (bottom, top) = (q[0].lerp(q[1], x), q[3].lerp(q[2], x));
-            let along_x = (q[1] - q[0]).lerp(q[2] - q[3], y);
-            (bottom.lerp(top, y), [along_x, top - bottom])
+            ColumnFace {
+                bottom,
+                top,
+                up: top - bottom,
+                along_bottom: q[1] - q[0],
+                along_top: q[2] - q[3],
+            }
         };
-        let (origin, d_origin) = at(&self.near);
-        let (far, d_far) = at(&self.far);
-        Ray {
-            origin,
-            dir: far - origin,
-            d_origin,
-            d_dir: [d_far[0] - d_origin[0], d_far[1] - d_origin[1]],
+        Column {
+            near: at(&self.near),
+            far: at(&self.far),
         }
     }
 
@@ -188,21 +256,63 @@ impl Screen {
     }
 }
 
+/// The rays through one screen column ([`Screen::column`]).
+struct Column {
+    near: ColumnFace,
+    far: ColumnFace,
+}
+
+/// One face of the frustum at a screen column: its points on the bottom and top
+/// edges, the step between them, and the edges' directions.
+struct ColumnFace {
+    bottom: DVec3,
+    top: DVec3,
+    up: DVec3,
+    along_bottom: DVec3,
+    along_top: DVec3,
+}
+
+impl ColumnFace {
+    /// The point at height `y` and its derivatives in `x` and `y`.
+    fn at(&self, y: f64) -> (DVec3, [DVec3; 2]) {
+        let along_x = self.along_bottom.lerp(self.along_top, y);
+        (self.bottom.lerp(self.top, y), [along_x, self.up])
+    }
+}
+
+impl Column {
+    /// The ray at height `y`: the bilinear interpolation of the near and of the far
+    /// face's corners, and its exact derivatives in `x` and `y`.
+    fn ray(&self, y: f64) -> Ray {
+        let (origin, d_origin) = self.near.at(y);
+        let (far, d_far) = self.far.at(y);
+        Ray {
+            origin,
+            dir: far - origin,
+            d_origin,
+            d_dir: [d_far[0] - d_origin[0], d_far[1] - d_origin[1]],
+        }
+    }
+}
+
 impl Probe {
-    /// No probe points; [`Probe::fill`] adds them. (A probe is large: it is filled
+    /// No probe points; [`Probe::fill`] casts them. (A probe is large: it is filled
     /// where it lives rather than moved.)
-    pub(crate) const fn new() -> Self {
+    pub(crate) fn new() -> Self {
         Self {
-            points: ArrayVec::new_const(),
-            perspective: ArrayVec::new_const(),
-            perspective_filled: false,
+            points: ProbePoints::new(),
             geometric: 0.0,
             rays: None,
         }
     }
 
-    /// Adds the probe points of `f` seen from `view` (the face-normal set; the
-    /// perspective set waits for [`Probe::strength`] to need it).
+    /// Whether [`Probe::fill`] has cast the points.
+    pub(crate) fn is_filled(&self) -> bool {
+        self.rays.is_some()
+    }
+
+    /// Casts the probe points of `f` seen from `view` (the face-normal set; the
+    /// perspective set is cast when [`Probe::strength`] needs it), replacing any.
     pub(crate) fn fill(&mut self, view: &View, f: &Focus) {
         let c = view.frustum.corners.map(glam::Vec3::as_dvec3);
         let screen = Screen {
@@ -223,58 +333,75 @@ impl Probe {
             step,
             light: f.light,
         };
-        self.geometric += rays.cast(Pass::Lit, &mut self.points);
+        self.points.clear();
+        self.geometric = rays.cast(Pass::Lit, &mut self.points);
         self.rays = Some(rays);
     }
 
-    /// Fills the perspective set, once.
-    fn fill_perspective(&mut self) {
-        if !self.perspective_filled {
-            if let Some(rays) = &self.rays {
-                rays.cast(Pass::Perspective, &mut self.perspective);
-            }
-            self.perspective_filled = true;
-        }
-    }
-
-    /// The predicted error `E` of the clip matrix `clip_from_world` (infinite when
-    /// a probe point falls behind its projection centre).
-    pub(crate) fn error(&self, clip_from_world: &DMat4) -> f64 {
-        points_error(&self.points, clip_from_world)
-    }
-
-    /// [`Probe::error`] with every point facing the bisector of the eye and light
-    /// directions: the perspective-only error.
-    pub(crate) fn perspective_error(&self, clip_from_world: &DMat4) -> f64 {
-        points_error(&self.perspective, clip_from_world)
-    }
-
     /// The fraction `t` in `[0, 1]` of a warp's formula strength to use, from its
-    /// clip matrix at a strength `t` (`None` where the fit fails): [`choose`] on the
-    /// predicted error, blended by [`Probe::confidence`] with [`choose`] on the
-    /// perspective-only error. Where the receivers' box shows few front-lit faces
-    /// (a light that grazes the ground, whose visible surfaces are then walls,
-    /// fences and trunks the box does not have) the parameterization alone decides:
-    /// falling back to the formula instead kept XPSM's length at a fence lit from
-    /// 3° above the horizon, predicted 2x the uniform fit's error and measured 1.57x.
-    /// Each fit is computed once for both errors.
-    pub(crate) fn strength(&mut self, mut clip_at: impl FnMut(f64) -> Option<DMat4>) -> f64 {
-        let confidence = self.confidence();
-        let mut clips: [Option<Option<DMat4>>; GRID] = [None; GRID];
-        let mut clip = |t: f64| {
-            let i = (math::round(t * (GRID - 1) as f64) as usize).min(GRID - 1);
-            *clips[i].get_or_insert_with(|| clip_at(t))
-        };
-        let lit = (confidence > 0.0)
-            .then(|| choose(|t| clip(t).map_or(f64::INFINITY, |c| self.error(&c))));
-        if let (Some(t), true) = (lit, confidence >= 1.0) {
-            return t;
-        }
-        self.fill_perspective();
-        let perspective = choose(|t| clip(t).map_or(f64::INFINITY, |c| self.perspective_error(&c)));
-        lit.map_or(perspective, |t| {
-            perspective + (t - perspective) * confidence
+    /// fit at a strength `t` (`None` where the fit fails) and that fit's clip
+    /// matrix: [`choose`] on the predicted error, blended by [`Probe::confidence`]
+    /// with [`choose`] on the perspective-only error (every point facing the
+    /// bisector of the eye and light directions). Where the receivers' box shows few
+    /// front-lit faces (a light that grazes the ground, whose visible surfaces are
+    /// then walls, fences and trunks the box does not have) the parameterization
+    /// alone decides: falling back to the formula instead kept XPSM's length at a
+    /// fence lit from 3° above the horizon, predicted 2x the uniform fit's error and
+    /// measured 1.57x. Each fit is made once for both errors, and the one at the
+    /// chosen `t` is returned where it was made (`t` one of the grid's, the usual
+    /// case: the formula's strength or the uniform fit), so the warp need not fit
+    /// it again.
+    pub(crate) fn strength<T>(
+        &self,
+        fit_at: impl FnMut(f64) -> Option<T>,
+        clip: impl Fn(&T) -> &DMat4,
+    ) -> (f64, Option<T>) {
+        self.strength_with(fit_at, clip, |out| {
+            if let Some(rays) = &self.rays {
+                rays.cast(Pass::Perspective, out);
+            }
         })
+    }
+
+    /// [`Probe::strength`] with the perspective set cast by `perspective` (only
+    /// where the confidence is below 1).
+    fn strength_with<T>(
+        &self,
+        mut fit_at: impl FnMut(f64) -> Option<T>,
+        clip: impl Fn(&T) -> &DMat4,
+        perspective: impl FnOnce(&mut ProbePoints),
+    ) -> (f64, Option<T>) {
+        let confidence = self.confidence();
+        let mut fits: [Option<Option<T>>; GRID] = [const { None }; GRID];
+        let grid_index = |t: f64| (math::round(t * (GRID - 1) as f64) as usize).min(GRID - 1);
+        let mut error_at = |t: f64, points: &ProbePoints| {
+            fits[grid_index(t)]
+                .get_or_insert_with(|| fit_at(t))
+                .as_ref()
+                .map_or(f64::INFINITY, |fit| points_error(points, clip(fit)))
+        };
+        let lit = (confidence > 0.0).then(|| choose(|t| error_at(t, &self.points)));
+        let t = match lit {
+            Some(t) if confidence >= 1.0 => t,
+            _ => {
+                let mut points = ProbePoints::new();
+                perspective(&mut points);
+                let perspective = choose(|t| error_at(t, &points));
+                lit.map_or(perspective, |t| {
+                    perspective + (t - perspective) * confidence
+                })
+            }
+        };
+        let i = grid_index(t);
+        let on_grid = t == i as f64 / (GRID - 1) as f64;
+        (
+            t,
+            if on_grid {
+                fits[i].take().flatten()
+            } else {
+                None
+            },
+        )
     }
 
     /// How far the prediction is to be trusted, in `[0, 1]`: 0 when no probe point
@@ -282,7 +409,7 @@ impl Probe {
     /// weight on, smooth in between, so that a fit can blend from its formula to the
     /// predicted choice continuously as surfaces turn toward the light.
     pub(crate) fn confidence(&self) -> f64 {
-        let lit: f64 = self.points.iter().map(|q| q.weight).sum();
+        let lit: f64 = self.points.weight.iter().sum();
         if self.geometric > 0.0 {
             smoothstep(0.0, 0.1, lit / self.geometric)
         } else {
@@ -292,30 +419,66 @@ impl Probe {
 }
 
 /// The power mean `E` of the aliasing error over `points` for `clip_from_world`
-/// (see [`Probe::error`]).
-fn points_error(points: &[Point], clip_from_world: &DMat4) -> f64 {
+/// (see the module's documentation), infinite when a point falls behind the
+/// projection centre.
+fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
     // Only clip x, y and w matter: the columns' (x, y, w), multiplied and summed
     // in the order of the matrix product (a direction's zero `w` term left out).
     let m = clip_from_world;
     let [cx, cy, cz, cw] =
         [m.x_axis, m.y_axis, m.z_axis, m.w_axis].map(|c| DVec3::new(c.x, c.y, c.w));
-    let (mut sum, mut weights) = (0.0, 0.0);
-    for q in points {
-        let h = cx * q.p.x + cy * q.p.y + cz * q.p.z + cw;
-        let hw = h.z;
-        if !(hw > 0.0) {
-            return f64::INFINITY;
-        }
+    let n = points.len().min(MAX_POINTS);
+    let [px, py, pz] = points.p.each_ref().map(|c| &c[..n]);
+    let [dxx, dxy, dxz] = points.dx.each_ref().map(|c| &c[..n]);
+    let [dyx, dyy, dyz] = points.dy.each_ref().map(|c| &c[..n]);
+    let (weight, fade) = (&points.weight[..n], &points.fade[..n]);
+    // Each point's term first, with no branch, so the loop runs on several points
+    // at once; then the sums, in the points' order (the same rounding as one loop).
+    let mut terms = [0.0; MAX_POINTS];
+    let mut behind = false;
+    let dx = |i: usize| DVec3::new(dxx[i], dxy[i], dxz[i]);
+    let dy = |i: usize| DVec3::new(dyx[i], dyy[i], dyz[i]);
+    // The term of point `i` from the moves in ndc `a` and `b` of its screen steps.
+    let term = |i: usize, a: DVec2, b: DVec2| {
+        let inv_s2 = math::inverse_square_smaller_singular_value(a, b);
+        (
+            weight[i] * pow4(inv_s2 * fade[i] * fade[i]),
+            !(inv_s2 < f64::INFINITY),
+        )
+    };
+    if cx.z == 0.0 && cy.z == 0.0 && cz.z == 0.0 && cw.z == 1.0 {
+        // An affine clip (every orthographic fit: a warp at strength 0) moves ndc
+        // by its x and y rows alone: `w = 1` and `dw = 0` exactly, so the general
+        // form below gives the same values, with three divisions more a point.
         let ndc = |d: DVec3| {
             let dh = cx * d.x + cy * d.y + cz * d.z;
-            (DVec2::new(dh.x, dh.y) * hw - DVec2::new(h.x, h.y) * dh.z) / (hw * hw)
+            DVec2::new(dh.x, dh.y)
         };
-        let inv_s2 = math::inverse_square_smaller_singular_value(ndc(q.dx), ndc(q.dy));
-        if !(inv_s2 < f64::INFINITY) {
-            return f64::INFINITY;
+        for (i, slot) in terms[..n].iter_mut().enumerate() {
+            let (t, bad) = term(i, ndc(dx(i)), ndc(dy(i)));
+            *slot = t;
+            behind |= bad;
         }
-        sum += q.weight * pow4(inv_s2 * q.fade * q.fade);
-        weights += q.weight;
+    } else {
+        for (i, slot) in terms[..n].iter_mut().enumerate() {
+            let h = cx * px[i] + cy * py[i] + cz * pz[i] + cw;
+            let hw = h.z;
+            let ndc = |d: DVec3| {
+                let dh = cx * d.x + cy * d.y + cz * d.z;
+                (DVec2::new(dh.x, dh.y) * hw - DVec2::new(h.x, h.y) * dh.z) / (hw * hw)
+            };
+            let (t, bad) = term(i, ndc(dx(i)), ndc(dy(i)));
+            *slot = t;
+            behind |= !(hw > 0.0) | bad;
+        }
+    }
+    if behind {
+        return f64::INFINITY;
+    }
+    let (mut sum, mut weights) = (0.0, 0.0);
+    for (term, weight) in terms[..n].iter().zip(weight) {
+        sum += term;
+        weights += weight;
     }
     if weights > 0.0 {
         math::powf(sum / weights, 1.0 / f64::from(POWER))
@@ -324,7 +487,8 @@ fn points_error(points: &[Point], clip_from_world: &DMat4) -> f64 {
     }
 }
 
-/// The probe points of the ray through `at` (see [`Probe::fill`]).
+/// The probe points of `ray`, whose segment in the receivers' box is `seg` (see
+/// [`Probe::fill`]).
 ///
 /// Where the surface a pixel sees lies is unknown; the receivers' box stands in for
 /// it: the face the ray enters through (eye outside the box), else the inner face
@@ -334,17 +498,13 @@ fn points_error(points: &[Point], clip_from_world: &DMat4) -> f64 {
 /// facing the bisector of the eye and light directions. Between these cases the
 /// weights blend over a 5% band of depth, and a face's normal over a 2% band near
 /// the box's edges, so every weight and normal is continuous.
-fn ray_points(rays: &Rays, at: DVec2, pass: Pass, out: &mut ArrayVec<Point, MAX_POINTS>) -> f64 {
-    let ray = rays.screen.ray(at.x, at.y);
-    let Some(seg) = Segment::new(&ray, &rays.screen, &rays.receivers) else {
-        return 0.0;
-    };
+fn ray_points(rays: &Rays, ray: &Ray, seg: &Segment, pass: Pass, out: &mut ProbePoints) -> f64 {
     let d = ray.dir;
     let light = rays.light;
-    let point = |s: f64, n: DVec3, weight: f64| point_at(&ray, rays.step, s, n, weight);
+    let point = |s: f64, n: DVec3, weight: f64| point_at(ray, rays.step, s, n, weight);
     let mut push = |q: Option<Point>| {
         if let Some(q) = q.filter(|q| q.weight > 0.0) {
-            let _ = out.try_push(q);
+            out.push(&q);
         }
     };
     // The bisector of the eye and light directions; where the light comes straight
@@ -471,6 +631,7 @@ impl Segment {
     /// an edge so that it turns continuously; `d` the ray's direction.
     fn face_normal(&self, s_face: f64, slabs: &[f64; 3], d: DVec3) -> DVec3 {
         let mut n = DVec3::ZERO;
+        let mut blended = 0;
         let depth_face = self.zn + s_face * (self.zf - self.zn);
         for axis in 0..3 {
             let apart = (s_face - slabs[axis]).abs() * (self.zf - self.zn);
@@ -482,9 +643,17 @@ impl Segment {
             let rel = apart / depth_face;
             let mut e = DVec3::ZERO;
             e[axis] = -d[axis].signum();
-            n += e * (1.0 - smoothstep(0.0, 0.02, rel));
+            let w = 1.0 - smoothstep(0.0, 0.02, rel);
+            n += e * w;
+            blended += usize::from(w != 1.0);
         }
-        n.normalize_or_zero()
+        // Away from the box's edges the normal is one axis at full weight, a unit
+        // vector already (normalizing it would return it unchanged).
+        if blended == 0 && n.length_squared() == 1.0 {
+            n
+        } else {
+            n.normalize_or_zero()
+        }
     }
 }
 
@@ -607,106 +776,4 @@ fn parabola_min(e: &[f64; GRID]) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A probe whose points face the bisector only (`lit` of their weight on the
-    /// box's faces): a grazing light, where no face of the receivers' box is lit.
-    fn probe(lit: f64) -> Probe {
-        let mut probe = Probe::new();
-        for k in 0..4 {
-            // Steps across x are the smaller on the bisector's plane...
-            let q = Point {
-                p: DVec3::new(f64::from(k), 0.5, -2.0),
-                dx: DVec3::new(1e-3, 0.0, 0.0),
-                dy: DVec3::new(0.0, 1.0, 0.0),
-                weight: 1.0,
-                fade: 1.0,
-            };
-            probe.perspective.push(q);
-            if lit > 0.0 {
-                // ... and down y on the lit faces.
-                probe.points.push(Point {
-                    weight: lit,
-                    dx: DVec3::new(1.0, 0.0, 0.0),
-                    dy: DVec3::new(0.0, 1e-3, 0.0),
-                    ..q
-                });
-            }
-            probe.geometric += 1.0;
-        }
-        probe.perspective_filled = true;
-        probe
-    }
-
-    /// With no front-lit face the strength is the one of least perspective-only
-    /// error, not the formula's: a warp whose full strength doubles the texels'
-    /// size (here the map shrinks as `t` grows) is not taken.
-    #[test]
-    fn without_lit_faces_the_perspective_error_chooses() {
-        let clip = |t: f64| Some(DMat4::from_scale(DVec3::new(2.0 - t, 2.0 - t, 1.0)));
-        let mut unlit = probe(0.0);
-        assert_eq!(unlit.confidence(), 0.0);
-        let t = unlit.strength(clip);
-        assert!(t < 0.05, "{t}");
-        // Fully confident, the lit faces' error decides: a map that grows along y
-        // and shrinks along x as `t` grows serves them best at `t = 1`, the
-        // bisector's plane at `t = 0`.
-        let squeeze = |t: f64| Some(DMat4::from_scale(DVec3::new(2.0 - t, 0.5 + t, 1.0)));
-        let mut lit = probe(1.0);
-        assert_eq!(lit.confidence(), 1.0);
-        assert!(lit.strength(squeeze) > 0.95);
-        assert!(unlit.strength(squeeze) < 0.5);
-    }
-
-    /// Where the ray through screen position `(x, y)` meets the plane through `p`
-    /// with normal `n`.
-    fn hit(screen: &Screen, x: f64, y: f64, p: DVec3, n: DVec3) -> DVec3 {
-        let r = screen.ray(x, y);
-        r.origin + r.dir * (n.dot(p - r.origin) / n.dot(r.dir))
-    }
-
-    /// The closed-form screen steps equal the central differences of the
-    /// neighbouring rays' hits on the probe plane, to the difference's own error.
-    #[test]
-    fn screen_steps_are_the_derivative_of_the_plane_hits() {
-        // A skewed frustum: no face is a rectangle, so the rays are bilinear.
-        let screen = Screen {
-            near: [
-                DVec3::new(-1.0, -0.5, -1.0),
-                DVec3::new(1.2, -0.6, -1.1),
-                DVec3::new(0.9, 0.7, -0.9),
-                DVec3::new(-1.1, 0.4, -1.0),
-            ],
-            far: [
-                DVec3::new(-60.0, -35.0, -100.0),
-                DVec3::new(70.0, -30.0, -95.0),
-                DVec3::new(55.0, 40.0, -105.0),
-                DVec3::new(-65.0, 30.0, -100.0),
-            ],
-            forward: DVec3::NEG_Z,
-            eye: DVec3::ZERO,
-        };
-        let step = DVec2::new(1e-3, 1e-3);
-        for (x, y, s, n) in [
-            (0.3, 0.2, 0.4, DVec3::Y),
-            (0.8, 0.6, 0.1, DVec3::new(0.3, 0.2, 0.93).normalize()),
-            (0.5, 0.9, 0.75, DVec3::new(-0.7, 0.1, 0.7).normalize()),
-        ] {
-            let ray = screen.ray(x, y);
-            let q = point_at(&ray, step, s, n, 1.0).unwrap();
-            assert!(q.p.distance(ray.origin + ray.dir * s) < 1e-12);
-            let h = 1e-4;
-            let dx = (hit(&screen, x + h, y, q.p, n) - hit(&screen, x - h, y, q.p, n)) / (2.0 * h);
-            let dy = (hit(&screen, x, y + h, q.p, n) - hit(&screen, x, y - h, q.p, n)) / (2.0 * h);
-            for (closed, differenced) in [(q.dx, dx * step.x), (q.dy, dy * step.y)] {
-                let error = (closed - differenced).length() / closed.length();
-                assert!(error < 1e-6, "{closed} vs {differenced}: {error}");
-                assert!(
-                    closed.dot(n).abs() < 1e-9 * closed.length(),
-                    "off the plane"
-                );
-            }
-        }
-    }
-}
+mod tests;

@@ -5,8 +5,7 @@ use glam::Vec3;
 use shadowmap_frustum::{Camera, MAX_BODY_VERTICES, ShadowTransform};
 
 use crate::FocusBody;
-use crate::focus::{Focus, View};
-use crate::lispsm::{chosen_strength, warp_fit};
+use crate::lispsm::fit_chosen;
 use crate::{MAX_WARP_RATIO, WarpError};
 use crate::{ParallelFade, SceneBounds};
 
@@ -160,11 +159,12 @@ impl FocusBody {
     /// [`WarpError::InvalidOption`]; [`WarpError::Degenerate`].
     pub fn tsm(&self, options: &TsmOptions) -> Result<TsmShadow, WarpError> {
         options.check()?;
-        tsm_body(&self.view, &self.focus, options)
+        tsm_body(self, options)
     }
 }
 
-fn tsm_body(view: &View, f: &Focus, options: &TsmOptions) -> Result<TsmShadow, WarpError> {
+fn tsm_body(body: &FocusBody, options: &TsmOptions) -> Result<TsmShadow, WarpError> {
+    let (view, f) = (&body.view, &body.focus);
     let fade = options.fade.weight(f.sin_gamma);
     // Top and base edges: the receivers' extent along the centre line.
     let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -196,8 +196,7 @@ fn tsm_body(view: &View, f: &Focus, options: &TsmOptions) -> Result<TsmShadow, W
         s = s.min((MAX_WARP_RATIO - 1.0) / lambda);
     }
     let s = if s.is_finite() { s * fade } else { 0.0 };
-    let s = chosen_strength(f, view, s, options.strength_scale);
-    let (transform, s) = warp_fit(f, view, s, options.reversed_z)?;
+    let (transform, s) = fit_chosen(body, s, options.strength_scale, options.reversed_z)?;
     Ok(TsmShadow {
         transform,
         eta: if s > 0.0 {

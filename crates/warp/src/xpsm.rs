@@ -8,7 +8,6 @@ use crate::FocusBody;
 use crate::WarpError;
 use crate::focus::{Bounds, Focus, View, finish, scale_of, smoothstep};
 use crate::lispsm::{scaled_strength, turn_invariant};
-use crate::predict::Probe;
 use shadowmap_frustum::math;
 
 /// Options of [`xpsm`].
@@ -254,11 +253,12 @@ impl FocusBody {
     /// [`WarpError::Degenerate`].
     pub fn xpsm(&self, options: &XpsmOptions) -> Result<XpsmShadow, WarpError> {
         options.validate()?;
-        xpsm_body(&self.view, &self.focus, options)
+        xpsm_body(self, options)
     }
 }
 
-fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow, WarpError> {
+fn xpsm_body(body: &FocusBody, options: &XpsmOptions) -> Result<XpsmShadow, WarpError> {
+    let (view, f) = (&body.view, &body.focus);
     // Steps 2-3: view vector in light space and its xy direction. The shared light
     // frame has +Y along V_xy whenever V_xy is not tiny, so unit P = (0, 1); in the
     // near-parallel band the frame follows the camera's up vector continuously.
@@ -272,18 +272,24 @@ fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow
             (faded_length(f64::from(c) / v_xy, y1 - y0, weight), 0.0)
         }
         Some(_) => (0.0, 0.0),
-        None => {
-            let (length, shift) = auto_length(f, view, weight);
-            // Scaled to 0 below whatever the prediction: skip it.
-            if options.strength_scale > 0.0 {
-                (predicted_length(view, f, options, length, shift), shift)
-            } else {
-                (length, shift)
-            }
+        None => auto_length(f, view, weight),
+    };
+    let space = XpsmSpace::new(view, f, options, shift);
+    // The automatic length after the prediction, and the prediction's fit with it
+    // where it made one (scaled to 0 below whatever the prediction: skipped).
+    let (length_p, predicted) = if options.coef.is_none() && options.strength_scale > 0.0 {
+        predicted_length(body, &space, options, length_p)
+    } else {
+        (length_p, None)
+    };
+    // A scale of 1 keeps the length exactly (`scaled_strength`), and so the fit.
+    let fit = match predicted {
+        Some(fit) if options.strength_scale >= 1.0 => fit,
+        _ => {
+            let length_p = scaled_strength(f, length_p, options.strength_scale);
+            xpsm_fit(&space, f, options, length_p)?
         }
     };
-    let length_p = scaled_strength(f, length_p, options.strength_scale);
-    let fit = xpsm_fit(view, f, options, length_p, shift)?;
     let transform = finish(
         f.rot,
         fit.clip,
@@ -317,15 +323,22 @@ fn xpsm_body(view: &View, f: &Focus, options: &XpsmOptions) -> Result<XpsmShadow
 /// camera looking down or toward the light, a body reaching far behind the viewer,
 /// or a projection vector clipped at the back-projection singularity (step 7),
 /// which magnifies the receivers nearest the singularity and starves the rest.
-fn predicted_length(view: &View, f: &Focus, options: &XpsmOptions, length: f64, shift: f64) -> f64 {
+/// Also the prediction's fit at that length, where it made one.
+fn predicted_length(
+    body: &FocusBody,
+    space: &XpsmSpace,
+    options: &XpsmOptions,
+    length: f64,
+) -> (f64, Option<XpsmFit>) {
+    let f = &body.focus;
     let (y0, y1) = f.warp_axis_range();
     let d = (y1 - y0).max(0.0);
     if !(length > 0.0 && d > 0.0) {
-        return length;
+        return (length, None);
     }
     let ln_r = math::ln(1.0 + length * d);
     if !(ln_r.is_finite() && ln_r > 0.0) {
-        return length;
+        return (length, None);
     }
     let at = |t: f64| {
         if t >= 1.0 {
@@ -334,14 +347,10 @@ fn predicted_length(view: &View, f: &Focus, options: &XpsmOptions, length: f64, 
             (math::exp(t * ln_r) - 1.0) / d
         }
     };
-    let mut probe = Probe::new();
-    probe.fill(view, f);
-    let t = probe.strength(|t| {
-        xpsm_fit(view, f, options, at(t), shift)
-            .ok()
-            .map(|fit| fit.clip)
-    });
-    at(t)
+    let (t, fit) = body
+        .probe()
+        .strength(|t| xpsm_fit(space, f, options, at(t)).ok(), |fit| &fit.clip);
+    (at(t), fit)
 }
 
 /// The fitted matrices of steps 1 and 4-17 for a given `lengthP`.
@@ -355,52 +364,95 @@ struct XpsmFit {
     max_length_p: f64,
 }
 
-/// Steps 1 and 4-17 for the projection length `length_p` of step 6 and the origin
-/// shift along `unit P`.
+/// What the fits of one XPSM call share, whatever their `lengthP` (step 1, the
+/// projections of step 4 and the bound of step 5): built once, so the prediction's
+/// fits at several lengths and the final one do not transform the body again.
+struct XpsmSpace {
+    /// Step 1: light space, origin at the viewer (moved along unit P by `shift`
+    /// for the automatic length), light along -Z.
+    light_space: DMat4,
+    /// The receivers and the caster box's corners in light space.
+    receivers: ArrayVec<DVec3, 64>,
+    casters: ArrayVec<DVec3, 8>,
+    /// Largest projection on unit P of either.
+    max_proj: f64,
+    /// Step 5: the longest projection vector (eq. 3).
+    max_length_p: f64,
+    /// The largest world coordinate the `f32` matrix computes `w` at.
+    world_scale: f64,
+}
+
+impl XpsmSpace {
+    /// The space of `f` seen from `view`, with the origin moved by `shift`.
+    fn new(view: &View, f: &Focus, options: &XpsmOptions, shift: f64) -> Self {
+        let eps_w = f64::from(options.epsilon_w);
+        let light_space = DMat4::from_translation(DVec3::new(0.0, -shift, 0.0))
+            * f.rot
+            * DMat4::from_translation(-view.eye);
+        let receivers: ArrayVec<DVec3, 64> = f
+            .receivers
+            .iter()
+            .map(|p| light_space.transform_point3(*p))
+            .collect();
+        let casters: ArrayVec<DVec3, 8> = f
+            .caster_box
+            .corners()
+            .iter()
+            .map(|p| light_space.transform_point3(p.as_dvec3()))
+            .collect();
+        let proj = |p: &DVec3| p.x * UNIT_P.x + p.y * UNIT_P.y;
+        // Step 4: minimal projections on unit P.
+        let min_casters = casters.iter().map(proj).fold(f64::INFINITY, f64::min);
+        let min_receivers = receivers.iter().map(proj).fold(f64::INFINITY, f64::min);
+        let max_proj = casters
+            .iter()
+            .chain(&receivers)
+            .map(proj)
+            .fold(f64::NEG_INFINITY, f64::max);
+        // Step 5: maximal length of the projection vector (eq. 3).
+        let min_focus = min_casters.max(min_receivers);
+        let scale = scale_of(&receivers).max(scale_of(&casters));
+        let max_length_p = if min_focus < -1e-12 * scale {
+            (eps_w - 1.0) / min_focus
+        } else {
+            f64::INFINITY
+        };
+        // The f32 matrix computes w in world coordinates: keep its rounding small
+        // (see MAX_WARP_RATIO).
+        let world_scale = f.caster_scale.max(
+            f.caster_box
+                .min
+                .abs()
+                .max(f.caster_box.max.abs())
+                .max_element()
+                .into(),
+        );
+        Self {
+            light_space,
+            receivers,
+            casters,
+            max_proj,
+            max_length_p,
+            world_scale,
+        }
+    }
+}
+
+/// Unit P in light space: the shared light frame has `+Y` along `V_xy`.
+const UNIT_P: glam::DVec2 = glam::DVec2::Y;
+
+/// Steps 4-17 for the projection length `length_p` of step 6 in `space`.
 fn xpsm_fit(
-    view: &View,
+    space: &XpsmSpace,
     f: &Focus,
     options: &XpsmOptions,
     mut length_p: f64,
-    shift: f64,
 ) -> Result<XpsmFit, WarpError> {
     let eps_w = f64::from(options.epsilon_w);
-    // Step 1: light space, origin at the viewer (moved along unit P by `shift` for
-    // the automatic length), light along -Z.
-    let light_space = DMat4::from_translation(DVec3::new(0.0, -shift, 0.0))
-        * f.rot
-        * DMat4::from_translation(-view.eye);
-    let unit_p = glam::DVec2::Y;
-
-    let receivers: ArrayVec<DVec3, 64> = f
-        .receivers
-        .iter()
-        .map(|p| light_space.transform_point3(*p))
-        .collect();
-    let casters: ArrayVec<DVec3, 8> = f
-        .caster_box
-        .corners()
-        .iter()
-        .map(|p| light_space.transform_point3(p.as_dvec3()))
-        .collect();
-    let proj = |p: &DVec3| p.x * unit_p.x + p.y * unit_p.y;
-
-    // Step 4: minimal projections on unit P.
-    let min_casters = casters.iter().map(proj).fold(f64::INFINITY, f64::min);
-    let min_receivers = receivers.iter().map(proj).fold(f64::INFINITY, f64::min);
-    let max_proj = casters
-        .iter()
-        .chain(&receivers)
-        .map(proj)
-        .fold(f64::NEG_INFINITY, f64::max);
-    // Step 5: maximal length of the projection vector (eq. 3).
-    let min_focus = min_casters.max(min_receivers);
-    let scale = scale_of(&receivers).max(scale_of(&casters));
-    let max_length_p = if min_focus < -1e-12 * scale {
-        (eps_w - 1.0) / min_focus
-    } else {
-        f64::INFINITY
-    };
+    let (light_space, unit_p) = (space.light_space, UNIT_P);
+    let (receivers, casters) = (&space.receivers, &space.casters);
+    let (max_proj, max_length_p, world_scale) =
+        (space.max_proj, space.max_length_p, space.world_scale);
     // Step 7: clip against the back-projection singularity.
     if max_length_p > 0.0 && length_p > max_length_p {
         length_p = max_length_p;
@@ -409,16 +461,6 @@ fn xpsm_fit(
     if max_proj > 0.0 {
         length_p = length_p.min((crate::MAX_WARP_RATIO - 1.0) / max_proj);
     }
-    // The f32 matrix computes w in world coordinates: keep its rounding small (see
-    // MAX_WARP_RATIO).
-    let world_scale = f.caster_scale.max(
-        f.caster_box
-            .min
-            .abs()
-            .max(f.caster_box.max.abs())
-            .max_element()
-            .into(),
-    );
     length_p = length_p.min(crate::MAX_WARP_RATIO / world_scale);
     // A footprint too thin for f32 texels gets the widened uniform fit.
     let wide = f.wide;
@@ -449,8 +491,8 @@ fn xpsm_fit(
     // relative margin so rounding cannot drop them.
     let eps_clip = eps_w * (1.0 - 1e-9);
     // Step 12: boxes.
-    let cbox = clipped_bounds(&ppls, &casters, eps_clip);
-    let rbox = clipped_bounds(&ppls, &receivers, eps_clip);
+    let cbox = clipped_bounds(&ppls, casters, eps_clip);
+    let rbox = clipped_bounds(&ppls, receivers, eps_clip);
     let (Some((cxy, cz)), Some((rxy, rz))) = (cbox, rbox) else {
         return Err(WarpError::EmptyFocusRegion);
     };
@@ -478,7 +520,7 @@ fn xpsm_fit(
     region.max.z = cz.1.max(rz.1);
     // Near the light frame's two zeros the region must not depend on how the frame
     // is turned (see `turn_invariant`).
-    let region = turn_invariant(region, f, view, &(ppls * light_space));
+    let region = turn_invariant(region, f, &(ppls * light_space));
     // Widen a thin region as the uniform fit does: relative to the focus body's
     // coordinates, where the lookup is evaluated, not to the far corners of the
     // caster box (which would make the miner's-lamp fit coarser than the uniform
@@ -595,10 +637,20 @@ fn auto_length(f: &Focus, view: &View, weight: f64) -> (f64, f64) {
 /// vertices). `None` when no vertex has `w >= eps_w`. The points are bounded as they
 /// are made, never stored.
 fn clipped_bounds(ppls: &DMat4, points: &[DVec3], eps_w: f64) -> Option<(Bounds, (f64, f64))> {
-    let hom: ArrayVec<Hom, 64> = points.iter().map(|p| *ppls * p.extend(1.0)).collect();
+    // Filled where it lives (a collected array is moved, two kilobytes a call).
+    let mut hom: ArrayVec<Hom, 64> = ArrayVec::new();
+    for p in points.iter().take(hom.capacity()) {
+        hom.push(*ppls * p.extend(1.0));
+    }
     let mut acc = CloudBounds::EMPTY;
+    let mut behind = false;
     for h in &hom {
         acc.add(*h, eps_w);
+        behind |= h.w < eps_w;
+    }
+    if !behind {
+        // Nothing to clip (the usual case): no pair to visit.
+        return acc.finish();
     }
     for a in hom.iter().filter(|h| h.w >= eps_w) {
         for b in hom.iter().filter(|h| h.w < eps_w) {
