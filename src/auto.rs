@@ -1,8 +1,9 @@
 //! `auto`: the candidate technique with the lowest predicted aliasing error.
 
 use arrayvec::ArrayVec;
-use shadowmap_frustum::{LightDirection, ShadowMapping};
-use shadowmap_warp::{LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
+use glam::Vec3;
+use shadowmap_frustum::{Light, LightDirection, ShadowMapping};
+use shadowmap_warp::{FocusBody, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 
 use crate::fit::{FitError, FitInput, FitState, fit_candidate, predicted_percentiles};
 use crate::sample_error::{PercentileBand, Samples, percentile_band, sample_error, sample_errors};
@@ -78,8 +79,17 @@ pub(crate) fn fit_auto(
     // cascades' count instead, a stable map turned along a fence's footprint (one
     // map, 2.6) stood in `auto` as four maps (4.5, `compare --seed 81 --sweep 64`,
     // random_fence_018).
+    // One focus body for the uniform fit and the three warps, so the warps cast its
+    // probe points once (`auto` is for directional lights alone; the body is read
+    // where it was built: it is large).
+    let direction = match *input.light {
+        Light::Directional { direction } => direction,
+        _ => Vec3::ZERO,
+    };
+    let built = FocusBody::new(input.camera, direction, &input.scene);
+    let body = built.as_ref().ok();
     for (slot, technique) in fitted.iter_mut().zip(&candidates) {
-        *slot = fit_candidate(technique, input, state).ok();
+        *slot = fit_candidate(technique, input, state, body).ok();
     }
     let percentiles = match directional_samples(input) {
         Some((samples, light)) if !samples.samples.is_empty() => {

@@ -12,7 +12,7 @@ use shadowmap_frustum::{
 };
 use shadowmap_paraboloid::{ParaboloidError, ParaboloidMap};
 use shadowmap_rtw::{EyeSample, ImportanceMap, OracleAxis, RtwError, RtwShadow, WarpMaps};
-use shadowmap_warp::{WarpError, spot_warp, uniform_focused};
+use shadowmap_warp::{FocusBody, WarpError, spot_warp, uniform_focused};
 
 use crate::cascaded::{fit_cascades, fit_warped};
 use crate::point_fit;
@@ -259,16 +259,19 @@ pub fn fit_with_state(
     if let Technique::Auto(plan) = technique {
         return crate::auto::fit_auto(plan, input, state);
     }
-    fit_candidate(technique, input, state)
+    fit_candidate(technique, input, state, None)
 }
 
-/// [`fit_with_state`] for every technique but `auto`, its inputs checked.
+/// [`fit_with_state`] for every technique but `auto`, its inputs checked; the
+/// uniform fit and the warps of a directional light fit from `body` where given
+/// (`auto` builds one for its candidates, so they cast its probe points once).
 pub(crate) fn fit_candidate(
     technique: &Technique,
     input: &FitInput<'_>,
     state: &mut FitState,
+    body: Option<&FocusBody>,
 ) -> Result<Shadow, FitError> {
-    let (fitted, layers) = fit_one(technique, input, state)?;
+    let (fitted, layers) = fit_one(technique, input, state, body)?;
     let layer_side = fitted
         .own_layer_side()
         .unwrap_or_else(|| input.layer_side(layers));
@@ -281,11 +284,13 @@ pub(crate) fn fit_candidate(
     })
 }
 
-/// The result and layer count of every technique but `auto`.
+/// The result and layer count of every technique but `auto` (the uniform fit and
+/// the warps from `body` where given).
 fn fit_one(
     technique: &Technique,
     input: &FitInput<'_>,
     state: &mut FitState,
+    body: Option<&FocusBody>,
 ) -> Result<(Fitted, u32), FitError> {
     let (camera, scene) = (input.camera, &input.scene);
     let direction = match *input.light {
@@ -294,11 +299,14 @@ fn fit_one(
     };
     Ok(match technique {
         Technique::UniformFocused(o) => (
-            Fitted::Uniform(uniform_focused(camera, direction, scene, o)?),
+            Fitted::Uniform(match body {
+                Some(body) => body.uniform(o)?,
+                None => uniform_focused(camera, direction, scene, o)?,
+            }),
             1,
         ),
         Technique::Lispsm(_) | Technique::Xpsm(_) | Technique::Tsm(_) => {
-            (fit_warp(technique, direction, input)?, 1)
+            (fit_warp(technique, direction, input, body)?, 1)
         }
         Technique::StableCascades(plan) => {
             fit_cascades(plan, true, direction, input, &mut state.cascades)?

@@ -29,18 +29,33 @@ const SCALES: [f32; 3] = [1.0, 0.5, 0.0];
 /// samples it was given: in a small room seen looking down, under a light from
 /// above, the box predicted the full warps 0.67 to 0.7 times the uniform fit's
 /// error and they measured 1.56 to 1.85 times it (the room's walls and furniture,
-/// not its floor, hold the largest errors).
+/// not its floor, hold the largest errors). From `shared` where given (`auto`
+/// fits its warps from one body), else from a body of its own.
 pub(crate) fn fit_warp(
     technique: &Technique,
     direction: Vec3,
     input: &FitInput<'_>,
+    shared: Option<&FocusBody>,
+) -> Result<Fitted, FitError> {
+    if shared.is_some() {
+        return fit_warp_from(technique, direction, input, shared);
+    }
+    // Read where it was built: a body is large (its probe points), and a body
+    // assigned to a variable declared before is built elsewhere and copied.
+    let built = FocusBody::new(input.camera, direction, &input.scene);
+    fit_warp_from(technique, direction, input, built.as_ref().ok())
+}
+
+/// [`fit_warp`] from `body`, one focus body for every strength tried, so its probe
+/// points are cast once. Where there is none (it failed), the warp's own entry
+/// point reports the error it reports (an invalid option before the body's).
+fn fit_warp_from(
+    technique: &Technique,
+    direction: Vec3,
+    input: &FitInput<'_>,
+    body: Option<&FocusBody>,
 ) -> Result<Fitted, FitError> {
     let (camera, scene) = (input.camera, &input.scene);
-    // One focus body for every strength tried, with its probe points cast once (it
-    // is read where it was built: a body is large). Where it fails, the warp's own
-    // entry point reports the error it reports (an invalid option before the body's).
-    let built = FocusBody::new(camera, direction, scene);
-    let body = built.as_ref().ok();
     let fit_at = |scale: f32| -> Result<Fitted, FitError> {
         Ok(match technique {
             Technique::Lispsm(o) => {
