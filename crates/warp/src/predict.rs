@@ -501,9 +501,8 @@ fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
 fn ray_points(rays: &Rays, ray: &Ray, seg: &Segment, pass: Pass, out: &mut ProbePoints) -> f64 {
     let d = ray.dir;
     let light = rays.light;
-    let point = |s: f64, n: DVec3, weight: f64| point_at(ray, rays.step, s, n, weight);
-    let mut push = |q: Option<Point>| {
-        if let Some(q) = q.filter(|q| q.weight > 0.0) {
+    let mut push = |s: f64, n: DVec3, weight: f64, fade: f64| {
+        if let Some(q) = point_at(ray, rays.step, s, n, weight, fade) {
             out.push(&q);
         }
     };
@@ -523,11 +522,11 @@ fn ray_points(rays: &Rays, ray: &Ray, seg: &Segment, pass: Pass, out: &mut Probe
         Pass::Lit => {
             let n = seg.face_normal(s, slabs, d);
             let lit = smoothstep(0.05, 0.1, -n.dot(light));
-            push(point(s, n, weight * lit).map(|q| Point { fade: lit, ..q }));
+            push(s, n, weight * lit, lit);
         }
         Pass::Perspective => {
             let (n_bisector, w_bisector) = bisector();
-            push(point(s, n_bisector, weight * w_bisector));
+            push(s, n_bisector, weight * w_bisector, 1.0);
         }
     };
     let (ray_weight, alpha, beta) = (seg.ray_weight, seg.alpha, seg.beta);
@@ -552,7 +551,7 @@ fn ray_points(rays: &Rays, ray: &Ray, seg: &Segment, pass: Pass, out: &mut Probe
     let root = math::sqrt(math::sqrt(math::sqrt(z1 / z0)));
     let mut z = z0 * root;
     for _ in 0..DEPTHS {
-        push(point((z - zn) / (zf - zn), n_bisector, w_volume));
+        push((z - zn) / (zf - zn), n_bisector, w_volume, 1.0);
         z *= root * root;
     }
     ray_weight
@@ -681,7 +680,8 @@ fn log_step(x: f64) -> f64 {
 /// derivative in a screen coordinate `u` is `P (o' + d' t)`, `P = I - d nᵀ / (n·d)`
 /// the projection along the ray onto the plane: what the neighbouring pixels'
 /// rays meet the plane at, in the limit of a small step.
-fn point_at(ray: &Ray, step: DVec2, s: f64, n: DVec3, weight: f64) -> Option<Point> {
+#[inline]
+fn point_at(ray: &Ray, step: DVec2, s: f64, n: DVec3, weight: f64, fade: f64) -> Option<Point> {
     if !(weight > 0.0) {
         return None;
     }
@@ -699,7 +699,7 @@ fn point_at(ray: &Ray, step: DVec2, s: f64, n: DVec3, weight: f64) -> Option<Poi
         dx: moved(0, step.x),
         dy: moved(1, step.y),
         weight,
-        fade: 1.0,
+        fade,
     };
     (q.p.is_finite() && q.dx.is_finite() && q.dy.is_finite()).then_some(q)
 }

@@ -99,7 +99,7 @@ fn screen_steps_are_the_derivative_of_the_plane_hits() {
         (0.5, 0.9, 0.75, DVec3::new(-0.7, 0.1, 0.7).normalize()),
     ] {
         let ray = screen.ray(x, y);
-        let q = point_at(&ray, step, s, n, 1.0).unwrap();
+        let q = point_at(&ray, step, s, n, 1.0, 1.0).unwrap();
         assert!(q.p.distance(ray.origin + ray.dir * s) < 1e-12);
         let h = 1e-4;
         let dx = (hit(&screen, x + h, y, q.p, n) - hit(&screen, x - h, y, q.p, n)) / (2.0 * h);
