@@ -1,8 +1,7 @@
 //! `auto`: the candidate technique with the lowest predicted aliasing error.
 
 use arrayvec::ArrayVec;
-use glam::Vec3;
-use shadowmap_frustum::{Light, LightDirection, ShadowMapping};
+use shadowmap_frustum::{LightDirection, ShadowMapping};
 use shadowmap_warp::{FocusBody, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions};
 
 use crate::fit::{FitError, FitInput, FitState, fit_candidate, predicted_percentiles};
@@ -82,11 +81,7 @@ pub(crate) fn fit_auto(
     // One focus body for the uniform fit and the three warps, so the warps cast its
     // probe points once (`auto` is for directional lights alone; the body is read
     // where it was built: it is large).
-    let direction = match *input.light {
-        Light::Directional { direction } => direction,
-        _ => Vec3::ZERO,
-    };
-    let built = FocusBody::new(input.camera, direction, &input.scene);
+    let built = FocusBody::new(input.camera, input.light_direction(), &input.scene);
     let body = built.as_ref().ok();
     for (slot, technique) in fitted.iter_mut().zip(&candidates) {
         *slot = fit_candidate(technique, input, state, body).ok();

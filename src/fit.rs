@@ -53,6 +53,15 @@ pub struct FitInput<'a> {
 }
 
 impl<'a> FitInput<'a> {
+    /// The direction a directional light travels; zero for a point or spot light
+    /// (which every directional builder refuses with its own error).
+    pub(crate) const fn light_direction(&self) -> Vec3 {
+        match *self.light {
+            Light::Directional { direction } => direction,
+            _ => Vec3::ZERO,
+        }
+    }
+
     /// The inputs every technique needs, none of the optional ones.
     #[must_use]
     pub const fn new(
@@ -293,10 +302,7 @@ fn fit_one(
     body: Option<&FocusBody>,
 ) -> Result<(Fitted, u32), FitError> {
     let (camera, scene) = (input.camera, &input.scene);
-    let direction = match *input.light {
-        Light::Directional { direction } => direction,
-        _ => Vec3::ZERO,
-    };
+    let direction = input.light_direction();
     Ok(match technique {
         Technique::UniformFocused(o) => (
             Fitted::Uniform(match body {

@@ -109,6 +109,8 @@ struct ProbePoints {
     dy: [ArrayVec<f64, MAX_POINTS>; 3],
     weight: ArrayVec<f64, MAX_POINTS>,
     fade: ArrayVec<f64, MAX_POINTS>,
+    /// The sum of `weight`, in the points' order (every error divides by it).
+    weight_sum: f64,
 }
 
 impl ProbePoints {
@@ -119,6 +121,7 @@ impl ProbePoints {
             dy: [ArrayVec::new(), ArrayVec::new(), ArrayVec::new()],
             weight: ArrayVec::new(),
             fade: ArrayVec::new(),
+            weight_sum: 0.0,
         }
     }
 
@@ -132,6 +135,7 @@ impl ProbePoints {
         }
         self.weight.clear();
         self.fade.clear();
+        self.weight_sum = 0.0;
     }
 
     /// Adds `q` unless the set is full.
@@ -146,6 +150,7 @@ impl ProbePoints {
         }
         self.weight.push(q.weight);
         self.fade.push(q.fade);
+        self.weight_sum += q.weight;
     }
 }
 
@@ -409,7 +414,7 @@ impl Probe {
     /// weight on, smooth in between, so that a fit can blend from its formula to the
     /// predicted choice continuously as surfaces turn toward the light.
     pub(crate) fn confidence(&self) -> f64 {
-        let lit: f64 = self.points.weight.iter().sum();
+        let lit = self.points.weight_sum;
         if self.geometric > 0.0 {
             smoothstep(0.0, 0.1, lit / self.geometric)
         } else {
@@ -475,11 +480,11 @@ fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
     if behind {
         return f64::INFINITY;
     }
-    let (mut sum, mut weights) = (0.0, 0.0);
-    for (term, weight) in terms[..n].iter().zip(weight) {
+    let mut sum = 0.0;
+    for term in &terms[..n] {
         sum += term;
-        weights += weight;
     }
+    let weights = points.weight_sum;
     if weights > 0.0 {
         math::powf(sum / weights, 1.0 / f64::from(POWER))
     } else {
