@@ -317,6 +317,15 @@ fn only(f: &Frame, out: &mut Outputs) -> bool {
     true
 }
 
+/// The table's rows named in `BUILDERS_TABLE` (comma-separated; Bevy's row is
+/// always timed, as the ratios' reference), or every row. With a filter that
+/// matches no criterion benchmark (`--bench builders/zzz`), the table of a few rows
+/// takes seconds: alternating runs of two builds compare them on a noisy machine.
+fn table_rows() -> Option<Vec<String>> {
+    let rows = std::env::var("BUILDERS_TABLE").ok()?;
+    Some(rows.split(',').map(|r| r.trim().to_owned()).collect())
+}
+
 #[allow(clippy::print_stdout)] // The table is this bench's output.
 fn builders(c: &mut Criterion) {
     let f = frame();
@@ -338,7 +347,15 @@ fn builders(c: &mut Criterion) {
 
     let bevy = timing::min_ns(|| run(&f, &mut out, 0));
     println!("builders, one run (time per call, fastest of 201 batches):");
+    let rows = table_rows();
     for (i, name) in NAMES.iter().enumerate() {
+        if !(i == 0
+            || rows
+                .as_ref()
+                .is_none_or(|r| r.iter().any(|row| row == name)))
+        {
+            continue;
+        }
         let t = if i == 0 {
             bevy
         } else {

@@ -236,6 +236,8 @@ pub(crate) struct Focus {
     pub(crate) light: DVec3,
     /// Light frame (rotation only).
     pub(crate) rot: DMat4,
+    /// The same in `f32`, the output's `light_from_world` (checked once per body).
+    pub(crate) light_from_world: Mat4,
     pub(crate) sin_gamma: f64,
     /// Vertices of frustum ∩ receivers (world).
     pub(crate) receivers: ReceiverPoints,
@@ -277,6 +279,10 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
         return Err(WarpError::NoVisibleReceivers);
     }
     let (rot, sin_gamma, axis_length) = frame_and_axis(dir, view.forward, view.up);
+    let light_from_world = rot.as_mat4();
+    if !matrix_ok(&light_from_world) {
+        return Err(WarpError::Degenerate);
+    }
     let receivers: ReceiverPoints = body.iter().map(|v| v.as_dvec3()).collect();
     // The receivers' light-space bounds: the caster prism's and the footprint's.
     let mut footprint = Bounds::EMPTY;
@@ -301,6 +307,7 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
         focus: Focus {
             light: dir,
             rot,
+            light_from_world,
             sin_gamma,
             wide: footprint_weight(&footprint, receiver_scale),
             turn_weight: crate::lispsm::turn_invariant_weight(axis_length),
@@ -378,7 +385,9 @@ impl FocusBody {
     /// [`WarpError::Frustum`] for an invalid camera; [`WarpError::NonFinite`],
     /// [`WarpError::ZeroDirection`] for the light; [`WarpError::EmptyReceivers`],
     /// [`WarpError::EmptyCasters`] for inverted boxes;
-    /// [`WarpError::NoVisibleReceivers`] when the receivers miss the frustum.
+    /// [`WarpError::NoVisibleReceivers`] when the receivers miss the frustum;
+    /// [`WarpError::Degenerate`] where the light frame's `f32` matrix is not
+    /// invertible (every fit of the body would be refused).
     pub fn new(
         camera: &Camera,
         light_direction: Vec3,
@@ -465,7 +474,7 @@ impl FocusBody {
     /// The light frame (rotation only, see [`light_frame`](crate::light_frame)).
     #[must_use]
     pub fn light_frame(&self) -> Mat4 {
-        self.focus.rot.as_mat4()
+        self.focus.light_from_world
     }
 
     /// `sin γ`, `γ` the angle between the viewing and the light direction.
@@ -614,31 +623,26 @@ pub(crate) fn ortho_fit(b: &Bounds, reversed_z: bool) -> DMat4 {
     )
 }
 
-/// Converts to the `f32` output, refusing non-finite or singular results: the
-/// matrices must be invertible for world coordinates up to `world_scale`
-/// (`shadowmap_frustum::is_invertible`).
+/// Converts a fit of `f` to the `f32` output, refusing non-finite or singular
+/// results: the matrix must be invertible for world coordinates up to
+/// `world_scale` (`shadowmap_frustum::is_invertible`). (The light frame's `f32`
+/// matrix was checked when the body was built.)
 pub(crate) fn finish(
-    light_from_world: DMat4,
+    f: &Focus,
     clip_from_world: DMat4,
     reversed_z: bool,
-    light: DVec3,
     world_scale: f64,
 ) -> Result<ShadowTransform, WarpError> {
     let clip = clip_from_world.as_mat4();
-    let lfw = light_from_world.as_mat4();
     let scale = world_scale as f32;
-    if !(matrix_ok(&clip)
-        && matrix_ok(&lfw)
-        && scale.is_finite()
-        && shadowmap_frustum::is_invertible(&clip, scale))
-    {
+    if !(matrix_ok(&clip) && scale.is_finite() && shadowmap_frustum::is_invertible(&clip, scale)) {
         return Err(WarpError::Degenerate);
     }
     let t = ShadowTransform::new(
-        lfw,
+        f.light_from_world,
         clip,
         reversed_z,
-        LightDirection::Directional(light.as_vec3()),
+        LightDirection::Directional(f.light.as_vec3()),
     );
     if !matrix_ok(&t.uv_from_world) {
         return Err(WarpError::Degenerate);

@@ -251,7 +251,7 @@ pub(crate) fn warp_fit(
     reversed_z: bool,
 ) -> Result<(ShadowTransform, f64), WarpError> {
     let (clip, s, scale) = warp_clip(f, view, s, reversed_z)?;
-    finish(f.rot, clip, reversed_z, f.light, scale).map(|t| (t, s))
+    finish(f, clip, reversed_z, scale).map(|t| (t, s))
 }
 
 /// The `f64` `clip_from_world` of [`warp_fit`], the `s` used and the world scale.
@@ -298,7 +298,7 @@ pub(crate) fn warp_clip(
     if b.is_empty() || !(b.min.is_finite() && b.max.is_finite()) {
         return Err(WarpError::Degenerate);
     }
-    let b = turn_invariant(b, f, &warp_from_world).padded(scale, 1.0 - wide);
+    let b = turn_invariant(b, f, || warp_from_world).padded(scale, 1.0 - wide);
     Ok((ortho_fit(&b, reversed_z) * warp_from_world, s, scale))
 }
 
@@ -322,11 +322,19 @@ const TURN_INVARIANT_BAND: (f64, f64) = (0.01, 0.02);
 /// texel size continuous there (the matrices still turn: no frame can avoid that).
 /// Every warp has faded to the uniform fit there, and the box is at most `sqrt 2`
 /// times larger, only within about a degree of one direction.
-pub(crate) fn turn_invariant(mut b: Bounds, f: &Focus, warp_from_world: &DMat4) -> Bounds {
+///
+/// `warp_from_world` gives the fit's matrix before its box (made only where the
+/// box is widened).
+pub(crate) fn turn_invariant(
+    mut b: Bounds,
+    f: &Focus,
+    warp_from_world: impl FnOnce() -> DMat4,
+) -> Bounds {
     let w = f.turn_weight;
     if !(w > 0.0) {
         return b;
     }
+    let warp_from_world = warp_from_world();
     let mut diameter = 0.0f64;
     for (i, p) in f.receivers.iter().enumerate() {
         let p = warp_from_world.project_point3(*p).truncate();
@@ -374,7 +382,7 @@ pub(crate) fn fit_chosen(
         Chosen {
             fitted: Some((clip, s, world_scale)),
             ..
-        } => finish(f.rot, clip, reversed_z, f.light, world_scale).map(|t| (t, s)),
+        } => finish(f, clip, reversed_z, world_scale).map(|t| (t, s)),
         Chosen { s, .. } => warp_fit(f, view, s, reversed_z),
     }
 }

@@ -96,8 +96,10 @@ struct Ray {
     d_dir: [DVec3; 2],
 }
 
+/// Probe rays.
+const RAYS: usize = COLUMNS * ROWS;
 /// Most probe points of a focus body.
-const MAX_POINTS: usize = COLUMNS * ROWS * DEPTHS;
+const MAX_POINTS: usize = RAYS * DEPTHS;
 
 /// Probe points stored by coordinate (one array per component of [`Point`]), so
 /// that [`points_error`]'s loop runs on several points at once (SIMD lanes), which
@@ -192,20 +194,32 @@ impl Rays {
         });
         // Every ray's segment first: the rays are independent, so their chains of
         // divisions overlap, where one ray's points after another's would wait on
-        // each in turn.
-        let mut segments: ArrayVec<(Ray, Segment), { COLUMNS * ROWS }> = ArrayVec::new();
+        // each in turn. Only the rays that meet the box need their derivatives.
+        let mut segments: ArrayVec<(usize, f64, Segment), RAYS> = ArrayVec::new();
         for row in 0..ROWS {
             let y = (row as f64 + 0.5) / ROWS as f64;
-            for column in &columns {
-                let ray = column.ray(y);
-                if let Some(segment) = Segment::new(&ray, &self.screen, &self.receivers) {
-                    segments.push((ray, segment));
+            for (i, column) in columns.iter().enumerate() {
+                let (origin, dir) = column.line(y);
+                if let Some(segment) = Segment::new(origin, dir, &self.screen, &self.receivers) {
+                    segments.push((i, y, segment));
                 }
             }
         }
+        // Where every ray's points lie first, then the points themselves: a point's
+        // divisions wait on its ray's choices (face, normal, weight), and made in a
+        // loop of their own, the divisions of several points run at once.
         let mut geometric = 0.0;
-        for (ray, segment) in &segments {
-            geometric += ray_points(self, ray, segment, pass, out);
+        let mut rays: ArrayVec<Ray, RAYS> = ArrayVec::new();
+        let mut planned: ArrayVec<PlannedPoint, { RAYS * (DEPTHS + 2) }> = ArrayVec::new();
+        for (i, y, segment) in &segments {
+            let ray = columns[*i].ray(*y);
+            geometric += ray_points(self, &ray, rays.len(), segment, pass, &mut planned);
+            rays.push(ray);
+        }
+        for w in &planned {
+            if let Some(q) = point_at(&rays[w.ray], self.step, w.s, w.n, w.weight, w.fade) {
+                out.push(&q);
+            }
         }
         geometric
     }
@@ -278,14 +292,26 @@ struct ColumnFace {
 }
 
 impl ColumnFace {
+    /// The point at height `y`.
+    fn point(&self, y: f64) -> DVec3 {
+        self.bottom.lerp(self.top, y)
+    }
+
     /// The point at height `y` and its derivatives in `x` and `y`.
     fn at(&self, y: f64) -> (DVec3, [DVec3; 2]) {
         let along_x = self.along_bottom.lerp(self.along_top, y);
-        (self.bottom.lerp(self.top, y), [along_x, self.up])
+        (self.point(y), [along_x, self.up])
     }
 }
 
 impl Column {
+    /// The origin and direction of the ray at height `y` (those of
+    /// [`Column::ray`], without its derivatives).
+    fn line(&self, y: f64) -> (DVec3, DVec3) {
+        let origin = self.near.point(y);
+        (origin, self.far.point(y) - origin)
+    }
+
     /// The ray at height `y`: the bilinear interpolation of the near and of the far
     /// face's corners, and its exact derivatives in `x` and `y`.
     fn ray(&self, y: f64) -> Ray {
@@ -438,14 +464,13 @@ fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
     let [dyx, dyy, dyz] = points.dy.each_ref().map(|c| &c[..n]);
     let (weight, fade) = (&points.weight[..n], &points.fade[..n]);
     // Each point's term first, with no branch, so the loop runs on several points
-    // at once; then the sums, in the points' order (the same rounding as one loop).
+    // at once; then their sum.
     let mut terms = [0.0; MAX_POINTS];
     let mut behind = false;
     let dx = |i: usize| DVec3::new(dxx[i], dxy[i], dxz[i]);
     let dy = |i: usize| DVec3::new(dyx[i], dyy[i], dyz[i]);
-    // The term of point `i` from the moves in ndc `a` and `b` of its screen steps.
-    let term = |i: usize, a: DVec2, b: DVec2| {
-        let inv_s2 = math::inverse_square_smaller_singular_value(a, b);
+    // The term of point `i` from `1 / s²` of its screen steps' moves in ndc.
+    let term = |i: usize, inv_s2: f64| {
         (
             weight[i] * pow4(inv_s2 * fade[i] * fade[i]),
             !(inv_s2 < f64::INFINITY),
@@ -454,13 +479,14 @@ fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
     if cx.z == 0.0 && cy.z == 0.0 && cz.z == 0.0 && cw.z == 1.0 {
         // An affine clip (every orthographic fit: a warp at strength 0) moves ndc
         // by its x and y rows alone: `w = 1` and `dw = 0` exactly, so the general
-        // form below gives the same values, with three divisions more a point.
+        // form below gives the same values, without the point's own `h` and `w⁴`.
         let ndc = |d: DVec3| {
             let dh = cx * d.x + cy * d.y + cz * d.z;
             DVec2::new(dh.x, dh.y)
         };
         for (i, slot) in terms[..n].iter_mut().enumerate() {
-            let (t, bad) = term(i, ndc(dx(i)), ndc(dy(i)));
+            let inv_s2 = math::inverse_square_smaller_singular_value(ndc(dx(i)), ndc(dy(i)));
+            let (t, bad) = term(i, inv_s2);
             *slot = t;
             behind |= bad;
         }
@@ -468,11 +494,16 @@ fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
         for (i, slot) in terms[..n].iter_mut().enumerate() {
             let h = cx * px[i] + cy * py[i] + cz * pz[i] + cw;
             let hw = h.z;
-            let ndc = |d: DVec3| {
+            // A move in ndc is `(dh.xy w - h.xy dh.w) / w²`: its `1 / s²` is that
+            // of the numerators times `w⁴` (one division a point, not five).
+            let moved = |d: DVec3| {
                 let dh = cx * d.x + cy * d.y + cz * d.z;
-                (DVec2::new(dh.x, dh.y) * hw - DVec2::new(h.x, h.y) * dh.z) / (hw * hw)
+                DVec2::new(dh.x, dh.y) * hw - DVec2::new(h.x, h.y) * dh.z
             };
-            let (t, bad) = term(i, ndc(dx(i)), ndc(dy(i)));
+            let w2 = hw * hw;
+            let inv_s2 =
+                math::inverse_square_smaller_singular_value(moved(dx(i)), moved(dy(i))) * (w2 * w2);
+            let (t, bad) = term(i, inv_s2);
             *slot = t;
             behind |= !(hw > 0.0) | bad;
         }
@@ -480,10 +511,19 @@ fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
     if behind {
         return f64::INFINITY;
     }
-    let mut sum = 0.0;
-    for term in &terms[..n] {
-        sum += term;
+    // Four interleaved partial sums (point `i` in sum `i % 4`), so the additions
+    // run side by side rather than as one chain through every point.
+    let mut lanes = [0.0f64; 4];
+    let chunks = terms[..n].chunks_exact(4);
+    for (lane, term) in lanes.iter_mut().zip(chunks.remainder()) {
+        *lane += term;
     }
+    for chunk in chunks {
+        for (lane, term) in lanes.iter_mut().zip(chunk) {
+            *lane += term;
+        }
+    }
+    let sum = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
     let weights = points.weight_sum;
     if weights > 0.0 {
         math::powf(sum / weights, 1.0 / f64::from(POWER))
@@ -503,13 +543,28 @@ fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
 /// facing the bisector of the eye and light directions. Between these cases the
 /// weights blend over a 5% band of depth, and a face's normal over a 2% band near
 /// the box's edges, so every weight and normal is continuous.
-fn ray_points(rays: &Rays, ray: &Ray, seg: &Segment, pass: Pass, out: &mut ProbePoints) -> f64 {
+///
+/// The points are added to `out` as planned (of the ray numbered `index`), to be
+/// made by [`point_at`] once every ray's are planned.
+fn ray_points(
+    rays: &Rays,
+    ray: &Ray,
+    index: usize,
+    seg: &Segment,
+    pass: Pass,
+    out: &mut ArrayVec<PlannedPoint, { RAYS * (DEPTHS + 2) }>,
+) -> f64 {
     let d = ray.dir;
     let light = rays.light;
     let mut push = |s: f64, n: DVec3, weight: f64, fade: f64| {
-        if let Some(q) = point_at(ray, rays.step, s, n, weight, fade) {
-            out.push(&q);
-        }
+        // At most two face points and `DEPTHS` volume points a ray: never full.
+        let _ = out.try_push(PlannedPoint {
+            ray: index,
+            s,
+            n,
+            weight,
+            fade,
+        });
     };
     // The bisector of the eye and light directions; where the light comes straight
     // at the viewer it vanishes, and the points facing it fade out.
@@ -562,6 +617,16 @@ fn ray_points(rays: &Rays, ray: &Ray, seg: &Segment, pass: Pass, out: &mut Probe
     ray_weight
 }
 
+/// A probe point to be made by [`point_at`]: its ray (by number), its parameter
+/// on the ray, the normal of the plane it lies on, its weight and its fade.
+struct PlannedPoint {
+    ray: usize,
+    s: f64,
+    n: DVec3,
+    weight: f64,
+    fade: f64,
+}
+
 /// A probe ray's segment inside the receivers' box: its parameters (`s`, 0 at the
 /// near face and 1 at the far face) and view depths, the slabs' entry and exit
 /// parameters, and the weights of [`ray_points`].
@@ -585,9 +650,9 @@ struct Segment {
 }
 
 impl Segment {
-    /// The segment of `ray` in box `b`; `None` where it misses the box.
-    fn new(ray: &Ray, screen: &Screen, b: &Bounds) -> Option<Self> {
-        let (o, d) = (ray.origin, ray.dir);
+    /// The segment in box `b` of the ray from `o` along `d`; `None` where it misses
+    /// the box.
+    fn new(o: DVec3, d: DVec3, screen: &Screen, b: &Bounds) -> Option<Self> {
         let (mut enter, mut exit) = ([f64::NEG_INFINITY; 3], [f64::INFINITY; 3]);
         for axis in 0..3 {
             if d[axis] == 0.0 {
@@ -620,13 +685,9 @@ impl Segment {
             zf,
             z0,
             z1,
-            ray_weight: log_step(z1 / z0).max(RAY_WEIGHT_FLOOR),
-            alpha: if s_enter > 0.0 {
-                log_step(z0 / zn)
-            } else {
-                0.0
-            },
-            beta: if s_exit < 1.0 { log_step(zf / z1) } else { 0.0 },
+            ray_weight: log_step(z1, z0).max(RAY_WEIGHT_FLOOR),
+            alpha: if s_enter > 0.0 { log_step(z0, zn) } else { 0.0 },
+            beta: if s_exit < 1.0 { log_step(zf, z1) } else { 0.0 },
         })
     }
 
@@ -665,15 +726,18 @@ impl Segment {
 /// `0.02` raised by a relative `1e-9`, far beyond rounding.
 const FACE_BAND_SATURATED: f64 = 0.020_000_000_02;
 
-/// `smoothstep(0, 0.05, ln x)`, the logarithm skipped where the step is 1: above
-/// `e^0.05` by a relative `1e-12` the logarithm exceeds `0.05` whatever its last
-/// bit.
-fn log_step(x: f64) -> f64 {
+/// `smoothstep(0, 0.05, ln(num / den))`, the logarithm skipped where the step is
+/// 1: above `e^0.05` by a relative `1e-12` the logarithm exceeds `0.05` whatever
+/// its last bit. That test compares `num` with `den` scaled (for `den > 0`), so a
+/// ray's branch does not wait on the division: where the product and the
+/// quotient round to opposite sides, the ratio is within a few units in the last
+/// place of the bound, and the logarithm's step is 1 there too.
+fn log_step(num: f64, den: f64) -> f64 {
     const SATURATED: f64 = 1.051_271_096_377_2; // e^0.05 (1 + 1.1e-12)
-    if x >= SATURATED {
+    if den > 0.0 && num >= SATURATED * den {
         1.0
     } else {
-        smoothstep(0.0, 0.05, math::ln(x))
+        smoothstep(0.0, 0.05, math::ln(num / den))
     }
 }
 

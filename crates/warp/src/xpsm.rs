@@ -2,11 +2,11 @@
 
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec3, DVec4, Vec3};
-use shadowmap_frustum::{Camera, ShadowTransform};
+use shadowmap_frustum::{Camera, MAX_FRUSTUM_AABB_VERTICES, ShadowTransform};
 
 use crate::FocusBody;
 use crate::WarpError;
-use crate::focus::{Bounds, Focus, View, finish, scale_of, smoothstep};
+use crate::focus::{Bounds, Focus, ReceiverPoints, View, finish, scale_of, smoothstep};
 use crate::lispsm::{scaled_strength, turn_invariant};
 use shadowmap_frustum::math;
 
@@ -290,13 +290,7 @@ fn xpsm_body(body: &FocusBody, options: &XpsmOptions) -> Result<XpsmShadow, Warp
             xpsm_fit(&space, f, options, length_p)?
         }
     };
-    let transform = finish(
-        f.rot,
-        fit.clip,
-        options.reversed_z,
-        f.light,
-        fit.world_scale,
-    )?;
+    let transform = finish(f, fit.clip, options.reversed_z, fit.world_scale)?;
     // The lookup is evaluated at the receivers: the matrix must resolve them too (a
     // depth range spanning absurdly tall casters can leave it singular there).
     if !shadowmap_frustum::is_invertible(&transform.clip_from_world, f.receiver_scale as f32) {
@@ -372,7 +366,7 @@ struct XpsmSpace {
     /// for the automatic length), light along -Z.
     light_space: DMat4,
     /// The receivers and the caster box's corners in light space.
-    receivers: ArrayVec<DVec3, 64>,
+    receivers: ReceiverPoints,
     casters: ArrayVec<DVec3, 8>,
     /// Largest projection on unit P of either.
     max_proj: f64,
@@ -389,7 +383,7 @@ impl XpsmSpace {
         let light_space = DMat4::from_translation(DVec3::new(0.0, -shift, 0.0))
             * f.rot
             * DMat4::from_translation(-view.eye);
-        let receivers: ArrayVec<DVec3, 64> = f
+        let receivers: ReceiverPoints = f
             .receivers
             .iter()
             .map(|p| light_space.transform_point3(*p))
@@ -520,7 +514,7 @@ fn xpsm_fit(
     region.max.z = cz.1.max(rz.1);
     // Near the light frame's two zeros the region must not depend on how the frame
     // is turned (see `turn_invariant`).
-    let region = turn_invariant(region, f, &(ppls * light_space));
+    let region = turn_invariant(region, f, || ppls * light_space);
     // Widen a thin region as the uniform fit does: relative to the focus body's
     // coordinates, where the lookup is evaluated, not to the far corners of the
     // caster box (which would make the miner's-lamp fit coarser than the uniform
@@ -637,8 +631,9 @@ fn auto_length(f: &Focus, view: &View, weight: f64) -> (f64, f64) {
 /// vertices). `None` when no vertex has `w >= eps_w`. The points are bounded as they
 /// are made, never stored.
 fn clipped_bounds(ppls: &DMat4, points: &[DVec3], eps_w: f64) -> Option<(Bounds, (f64, f64))> {
-    // Filled where it lives (a collected array is moved, two kilobytes a call).
-    let mut hom: ArrayVec<Hom, 64> = ArrayVec::new();
+    // Filled where it lives (a collected array is moved, a kilobyte a call); as
+    // many as the focus body's receivers (the caster box has 8 corners).
+    let mut hom: ArrayVec<Hom, MAX_FRUSTUM_AABB_VERTICES> = ArrayVec::new();
     for p in points.iter().take(hom.capacity()) {
         hom.push(*ppls * p.extend(1.0));
     }
