@@ -8,7 +8,9 @@
 //! body built once (`FocusBody`: what a frame pays per technique once the body and
 //! its probe points, cast by the first warp fitted from it, are shared), LiSPSM from
 //! a body built in the call (`lispsm_valid`: a frame with one warped light), the IPSM
-//! plan from the validated camera (`ipsm_plan_exact_cone_valid`), and the
+//! plan from the validated camera (`ipsm_plan_exact_cone_valid`), the body and
+//! its four fits under a sun 2° above the horizon (`focus_body_valid_all_4_low_sun`:
+//! the warps then choose on the probe's perspective set), and the
 //! 4-cascade fits refitted in place into a set kept across calls
 //! (`CascadeSet::refit_valid`), and the held stable fit (`CascadeSet::fit_with_state`,
 //! maps fitted to slice ∩ receivers with their sizes kept in a state across calls).
@@ -43,6 +45,9 @@ mod timing;
 struct Frame {
     camera: Camera,
     light: Vec3,
+    /// A sun 2° above the horizon: no face of the receivers' box is lit enough to
+    /// trust, so the warps choose on the probe's perspective set.
+    low_sun: Vec3,
     light_rotation: Quat,
     far_bounds: [f32; bevy_like::CASCADES],
     splits: CascadeSplits,
@@ -95,6 +100,10 @@ fn frame() -> Frame {
     Frame {
         camera,
         light,
+        low_sun: {
+            let (sin, cos) = 2.0f32.to_radians().sin_cos();
+            (Vec3::new(-0.4, 0.0, -0.6).normalize() * cos - Vec3::Y * sin).normalize()
+        },
         light_rotation: Quat::from_rotation_arc(Vec3::NEG_Z, light),
         far_bounds,
         splits,
@@ -133,7 +142,7 @@ struct Outputs {
 }
 
 /// The builders, by name.
-const NAMES: [&str; 26] = [
+const NAMES: [&str; 27] = [
     "bevy_cascades_4",
     "uniform_focused",
     "stable_cascades_4",
@@ -160,6 +169,7 @@ const NAMES: [&str; 26] = [
     "stable_cascades_4_held",
     "lispsm_valid",
     "ipsm_plan_exact_cone_valid",
+    "focus_body_valid_all_4_low_sun",
 ];
 
 /// Keeps a builder's result where it was returned (the output is not moved out of
@@ -244,7 +254,8 @@ fn run(f: &Frame, out: &mut Outputs, which: usize) {
         14 => {
             keep(&CascadeSet::fit_valid(&f.valid, light, &f.splits, &f.tight));
         }
-        15 => {
+        15 | 26 => {
+            let light = if which == 15 { light } else { f.low_sun };
             let body = FocusBody::new_valid(black_box(&f.valid), light, &f.scene);
             let body = body.as_ref().unwrap();
             keep(&body.uniform(&UniformOptions::default()));

@@ -1,5 +1,6 @@
 //! The probe's strength choice and screen steps.
 
+use super::rays::{Screen, log_step, point_at};
 use super::*;
 
 /// A probe whose points face the bisector only (`lit` of their weight on the
@@ -36,12 +37,11 @@ fn strength(
     (probe, perspective): &(Probe, Vec<Point>),
     clip: impl FnMut(f64) -> Option<DMat4>,
 ) -> f64 {
-    let perspective = |out: &mut ProbePoints| {
-        for q in perspective {
-            out.push(q);
-        }
-    };
-    probe.strength_with(clip, |c| c, perspective).0
+    let mut points = ProbePoints::new();
+    for q in perspective {
+        points.push(q);
+    }
+    probe.strength_with(clip, |c| c, &points).0
 }
 
 /// With no front-lit face the strength is the one of least perspective-only
@@ -110,6 +110,92 @@ fn screen_steps_are_the_derivative_of_the_plane_hits() {
             assert!(
                 closed.dot(n).abs() < 1e-9 * closed.length(),
                 "off the plane"
+            );
+        }
+    }
+}
+
+/// The predicted error read off its definition: each point's ndc steps by the
+/// quotient rule, the smaller singular value of that Jacobian, and the power mean of
+/// `fade / s_min` weighted by `weight` (summed in the points' order).
+fn error_by_definition(points: &[Point], clip_from_world: &DMat4) -> f64 {
+    let (mut sum, mut weights) = (0.0, 0.0);
+    for q in points {
+        let h = *clip_from_world * q.p.extend(1.0);
+        let ndc = |d: DVec3| {
+            let dh = *clip_from_world * d.extend(0.0);
+            (DVec2::new(dh.x, dh.y) * h.w - DVec2::new(h.x, h.y) * dh.w) / (h.w * h.w)
+        };
+        let s_min = math::smaller_singular_value(ndc(q.dx), ndc(q.dy));
+        sum += q.weight * (q.fade / s_min).powi(POWER);
+        weights += q.weight;
+    }
+    (sum / weights).powf(1.0 / f64::from(POWER))
+}
+
+proptest::proptest! {
+    /// `points_error` (the Jacobian's `1 / s²` from the numerators of the
+    /// quotient rule times `w⁴`, the terms summed four at a time) is the error of
+    /// its definition to rounding, for perspective clips (a LiSPSM-like warp of
+    /// any strength along any axis) and affine ones.
+    #[test]
+    fn the_error_is_its_definition(
+        seed in proptest::collection::vec(-1.0f64..1.0, 7 * 23),
+        strength in 0.0f64..2.0,
+        axis in proptest::sample::select(vec![DVec3::X, DVec3::Y, DVec3::new(0.6, 0.0, 0.8)]),
+        n in 1usize..23,
+    ) {
+        let points: Vec<Point> = seed
+            .chunks_exact(7)
+            .take(n)
+            .map(|c| Point {
+                p: DVec3::new(c[0], c[1], c[2]) * 5.0,
+                dx: DVec3::new(1e-3, c[3] * 1e-3, 0.0),
+                dy: DVec3::new(c[4] * 1e-3, 1e-3, c[5] * 1e-4),
+                weight: 0.5 + 0.5 * c[6].abs(),
+                fade: 0.2 + 0.8 * c[6].abs(),
+            })
+            .collect();
+        let mut probe = ProbePoints::new();
+        for q in &points {
+            probe.push(q);
+        }
+        // A depth along `axis` of 3.5 to 17.5 divides x and y:
+        // `w = 1 + s (axis·p + 10.5)`, `|axis·p| <= 7`.
+        let w_row = (axis * strength).extend(1.0 + 10.5 * strength);
+        let clip = DMat4::from_cols_array_2d(&[
+            [0.1, 0.02, 0.0, w_row.x],
+            [-0.03, 0.12, 0.0, w_row.y],
+            [0.01, 0.0, 0.05, w_row.z],
+            [0.2, -0.1, 0.5, w_row.w],
+        ]);
+        for m in [clip, DMat4::from_scale(DVec3::new(0.1, 0.07, 0.05))] {
+            let fast = points_error(&probe, &m);
+            let reference = error_by_definition(&points, &m);
+            proptest::prop_assert!(
+                (fast - reference).abs() <= 1e-12 * reference,
+                "{fast} vs {reference}"
+            );
+        }
+    }
+}
+
+/// The ray weights' step saturates on a product test (no wait on the division):
+/// it agrees bit for bit with the step of the quotient, also within a few units in
+/// the last place of the bound, where the two tests can disagree.
+#[test]
+fn the_log_step_saturation_is_the_quotients() {
+    const SATURATED: f64 = 1.051_271_096_377_2;
+    let by_quotient = |num: f64, den: f64| smoothstep(0.0, 0.05, math::ln(num / den));
+    for den in [1e-4, 0.37, 1.0, 3.3, 7.1e3, 2.5e6] {
+        let near_bound = (-16..=16).map(|k| SATURATED * (1.0 + f64::from(k) * f64::EPSILON));
+        let spread = (0..200).map(|k| 1.0 + f64::from(k) * 0.0005);
+        for ratio in near_bound.chain(spread) {
+            let num = ratio * den;
+            assert_eq!(
+                log_step(num, den).to_bits(),
+                by_quotient(num, den).to_bits(),
+                "{num} / {den}"
             );
         }
     }
