@@ -304,11 +304,19 @@ impl Pass<'_> {
                 // Where the neighbouring pixels' rays meet each point's plane: the
                 // same for every candidate, computed once.
                 let steps = hit.map(|point, normal| self.screen.pixel_steps(at, point, normal));
-                let mut ray = [None; MAX_PREDICT_CANDIDATES];
-                for (m, &(mapping, side)) in ray.iter_mut().zip(candidates) {
-                    *m = hit.error(&steps, |point, steps| {
-                        error_at(point, steps.as_ref()?, mapping, f64::from(side))
+                // Every candidate's differentials at the hit's points first, then
+                // the errors: their square roots and divisions (most of a
+                // candidate's time) run side by side, not each after its
+                // candidate's matrix products.
+                let mut differentials = [[None; DEPTH_POINTS]; MAX_PREDICT_CANDIDATES];
+                for (d, &(mapping, side)) in differentials.iter_mut().zip(candidates) {
+                    *d = hit.map_with(&steps, |point, steps| {
+                        texel_differentials(point, steps.as_ref()?, mapping, f64::from(side))
                     });
+                }
+                let mut ray = [None; MAX_PREDICT_CANDIDATES];
+                for (m, d) in ray.iter_mut().zip(&differentials[..n]) {
+                    *m = hit.error(d, |_, d| error_of(d.as_ref()?));
                 }
                 if self.shared && ray[..n].iter().any(Option::is_none) {
                     continue;
@@ -353,12 +361,22 @@ impl Hit {
 
     /// `f(point, normal)` for each of the hit's points (one for a face).
     fn map<T: Copy + Default>(&self, mut f: impl FnMut(DVec3, DVec3) -> T) -> [T; DEPTH_POINTS] {
-        let mut out = [T::default(); DEPTH_POINTS];
+        self.map_with(&[self.normal(); DEPTH_POINTS], |p, n| f(p, *n))
+    }
+
+    /// `f(point, data)` for each of the hit's points, `data` the point's entry of
+    /// `per_point` ([`Hit::map`]).
+    fn map_with<T, U: Copy + Default>(
+        &self,
+        per_point: &[T; DEPTH_POINTS],
+        mut f: impl FnMut(DVec3, &T) -> U,
+    ) -> [U; DEPTH_POINTS] {
+        let mut out = [U::default(); DEPTH_POINTS];
         match self {
-            Self::Face(p, n) => out[0] = f(*p, *n),
-            Self::Range(points, n) => {
-                for (o, p) in out.iter_mut().zip(points) {
-                    *o = f(*p, *n);
+            Self::Face(p, _) => out[0] = f(*p, &per_point[0]),
+            Self::Range(points, _) => {
+                for ((o, p), data) in out.iter_mut().zip(points).zip(per_point) {
+                    *o = f(*p, data);
                 }
             }
         }
@@ -523,16 +541,23 @@ impl Screen {
 /// The points one pixel away on a probe point's plane ([`Screen::pixel_steps`]).
 type PixelSteps = [DVec3; 4];
 
-/// `m²` at `point` with the neighbouring pixels' points `steps`, if the mapping
-/// covers the pixel and its neighbours in one layer.
-fn error_at(
+/// The map's differentials in texels at `point` for the neighbouring pixels'
+/// points `steps` (its [`error_of`]), if the mapping covers the pixel and its
+/// neighbours in one layer.
+fn texel_differentials(
     point: DVec3,
     steps: &PixelSteps,
     mapping: &dyn ShadowMapping,
     texels: f64,
-) -> Option<f64> {
+) -> Option<[DVec2; 2]> {
     let [du, dv] = mapping.uv_differentials(point, steps)?;
-    let m2 = math::inverse_square_smaller_singular_value(du * texels, dv * texels);
+    Some([du * texels, dv * texels])
+}
+
+/// `m²` of the texel differentials `[du, dv]` ([`texel_differentials`]), if finite
+/// and positive.
+fn error_of(&[du, dv]: &[DVec2; 2]) -> Option<f64> {
+    let m2 = math::inverse_square_smaller_singular_value(du, dv);
     (m2.is_finite() && m2 > 0.0).then_some(m2)
 }
 
