@@ -268,8 +268,9 @@ impl Focus {
     }
 }
 
-/// The focus body of `view` and `light`, written where it is returned (the body is a
-/// few kilobytes of fixed-capacity arrays: built field by field in place, not moved).
+/// The focus body of `view` and `light`, written where it is returned (the body is
+/// tens of kilobytes of fixed-capacity arrays: built field by field in place, not
+/// moved).
 fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, WarpError> {
     let dir = light_unit(light)?;
     let (receivers, casters) = check_scene(scene)?;
@@ -334,7 +335,9 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
 /// of the body (most of a warp's time); the body fills those points when the first
 /// warp needs them and keeps them, so LiSPSM, XPSM and TSM from one body (or one
 /// warp at several strength scales) cast the probe rays once. That cache makes a
-/// body `Send` but not `Sync`: fit from one thread, or clone it per thread.
+/// body `Send` but not `Sync`: fit from one thread, or clone it per thread. The
+/// points are fixed-capacity arrays (no allocation), so a body is about 37 KB:
+/// build it where it is used, or keep one per light, rather than moving it.
 /// The free functions ([`uniform_focused`](crate::uniform_focused),
 /// [`lispsm`](crate::lispsm), ...) build one and call these.
 ///
@@ -397,8 +400,8 @@ impl FocusBody {
     }
 
     /// `fit` applied to the focus body of a camera's whole frustum, read where it was
-    /// built: the body is a few kilobytes of fixed-capacity arrays, and moving it out
-    /// of its `Result` first would copy them (what the free functions
+    /// built: the body is tens of kilobytes of fixed-capacity arrays, and moving it
+    /// out of its `Result` first would copy them (what the free functions
     /// [`uniform_focused`](crate::uniform_focused), [`lispsm`](crate::lispsm), ...
     /// call).
     pub(crate) fn fit_from<T>(

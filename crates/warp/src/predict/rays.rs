@@ -67,8 +67,9 @@ impl Rays {
             geometric += ray_points(self, &ray, rays.len(), segment, pass, &mut planned);
             rays.push(ray);
         }
-        for w in &planned {
-            if let Some(q) = point_at(&rays[w.ray], self.step, w.s, w.n, w.weight, w.fade) {
+        for plan in &planned {
+            let ray = &rays[plan.ray];
+            if let Some(q) = point_at(ray, self.step, plan.s, plan.n, plan.weight, plan.fade) {
                 out.push(&q);
             }
         }
