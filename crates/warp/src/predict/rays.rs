@@ -37,6 +37,29 @@ pub(super) struct Rays {
 }
 
 impl Rays {
+    /// The rays of `view` through the receivers' box of `f`.
+    pub(super) fn new(view: &View, f: &Focus) -> Self {
+        let c = view.frustum.corners.map(glam::Vec3::as_dvec3);
+        let screen = Screen {
+            near: [c[0], c[1], c[2], c[3]],
+            far: [c[4], c[5], c[6], c[7]],
+            forward: view.forward,
+            eye: view.eye,
+        };
+        let aspect = (c[1] - c[0]).length() / (c[3] - c[0]).length();
+        let step = DVec2::new(STEP / aspect.max(1e-12), STEP);
+        let mut receivers = Bounds::EMPTY;
+        for p in &f.receivers {
+            receivers.add(*p);
+        }
+        Self {
+            screen,
+            receivers,
+            step,
+            light: f.light,
+        }
+    }
+
     /// Adds the points of `pass` of every ray to `out`, row by row; returns the sum
     /// of the rays' weights.
     pub(super) fn cast(&self, pass: Pass, out: &mut ProbePoints) -> f64 {
@@ -149,10 +172,9 @@ impl ColumnFace {
         self.bottom.lerp(self.top, y)
     }
 
-    /// The point at height `y` and its derivatives in `x` and `y`.
-    fn at(&self, y: f64) -> (DVec3, [DVec3; 2]) {
-        let along_x = self.along_bottom.lerp(self.along_top, y);
-        (self.point(y), [along_x, self.up])
+    /// The derivatives in `x` and `y` of the point at height `y`.
+    fn derivatives(&self, y: f64) -> [DVec3; 2] {
+        [self.along_bottom.lerp(self.along_top, y), self.up]
     }
 }
 
@@ -167,38 +189,13 @@ impl Column {
     /// The ray at height `y`: the bilinear interpolation of the near and of the far
     /// face's corners, and its exact derivatives in `x` and `y`.
     fn ray(&self, y: f64) -> Ray {
-        let (origin, d_origin) = self.near.at(y);
-        let (far, d_far) = self.far.at(y);
+        let (origin, dir) = self.line(y);
+        let (d_origin, d_far) = (self.near.derivatives(y), self.far.derivatives(y));
         Ray {
             origin,
-            dir: far - origin,
+            dir,
             d_origin,
             d_dir: [d_far[0] - d_origin[0], d_far[1] - d_origin[1]],
-        }
-    }
-}
-
-impl Rays {
-    /// The rays of `view` through the receivers' box of `f`.
-    pub(super) fn new(view: &View, f: &Focus) -> Self {
-        let c = view.frustum.corners.map(glam::Vec3::as_dvec3);
-        let screen = Screen {
-            near: [c[0], c[1], c[2], c[3]],
-            far: [c[4], c[5], c[6], c[7]],
-            forward: view.forward,
-            eye: view.eye,
-        };
-        let aspect = (c[1] - c[0]).length() / (c[3] - c[0]).length();
-        let step = DVec2::new(STEP / aspect.max(1e-12), STEP);
-        let mut receivers = Bounds::EMPTY;
-        for p in &f.receivers {
-            receivers.add(*p);
-        }
-        Self {
-            screen,
-            receivers,
-            step,
-            light: f.light,
         }
     }
 }
@@ -239,10 +236,13 @@ fn ray_points(
     };
     // The bisector of the eye and light directions; where the light comes straight
     // at the viewer it vanishes, and the points facing it fade out.
-    let bisector = || {
-        let bisector = -d.normalize_or_zero() - light;
-        let facing = bisector.length();
-        (bisector / facing, smoothstep(0.0, 0.1, facing))
+    let mut facing_bisector = None;
+    let mut bisector = || {
+        *facing_bisector.get_or_insert_with(|| {
+            let bisector = -d.normalize_or_zero() - light;
+            let facing = bisector.length();
+            (bisector / facing, smoothstep(0.0, 0.1, facing))
+        })
     };
     // A face point: on the face with its normal where front-lit (only front-lit
     // surfaces matter: within about 3° of parallel to the light shading darkens a
