@@ -171,7 +171,7 @@ impl FrustumBox<'_> {
     /// crossings within `tol / L` of an end can pass (twice that is tried).
     fn frustum_edges(&self, c: &[DVec3; 8], push: &mut impl FnMut(DVec3)) {
         let bounds = [self.lo.to_array(), self.hi.to_array()];
-        for ((i, j), (end_i, end_j)) in FRUSTUM_EDGES.into_iter().zip(EDGE_END_PLANES) {
+        for (&(i, j), &(end_i, end_j)) in FRUSTUM_EDGES.iter().zip(&EDGE_END_PLANES) {
             let (p, q) = (c[i], c[j]);
             let (pa, qa) = (p.to_array(), q.to_array());
             // The range past the ends, needed only for crossings off the edge.

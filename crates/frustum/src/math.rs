@@ -144,8 +144,12 @@ pub fn acos_clamped(x: f64) -> f64 {
 pub fn inverse_square_smaller_singular_value(a: glam::DVec2, b: glam::DVec2) -> f64 {
     let frobenius = a.length_squared() + b.length_squared();
     let det = a.perp_dot(b);
-    let root = sqrt((frobenius * frobenius - 4.0 * det * det).max(0.0));
-    let inv = (frobenius + root) / (2.0 * det * det);
+    // `D²` once: scaling it by 4 or 2 is exact, so `4 D²` and `2 D²` are the
+    // products `4 D D` and `2 D D` bit for bit (short of underflow, where the
+    // result is past any error that matters).
+    let det2 = det * det;
+    let root = sqrt((frobenius * frobenius - 4.0 * det2).max(0.0));
+    let inv = (frobenius + root) / (2.0 * det2);
     if inv > 0.0 { inv } else { f64::INFINITY }
 }
 
@@ -222,6 +226,27 @@ mod tests {
             for v in [y, -y, y.floor() + 0.5, -(y.floor() + 0.5)] {
                 prop_assert_eq!(super::round(v).to_bits(), v.round().to_bits(), "{}", v);
             }
+        }
+
+        /// `inverse_square_smaller_singular_value` with `D²` taken once is the
+        /// formula with `4 D D` and `2 D D`, bit for bit, over matrices whose
+        /// entries span 2^-60 to 2^60.
+        #[test]
+        fn the_shared_square_of_the_determinant_is_exact(
+            m in proptest::array::uniform4(-1.0f64..1.0),
+            scales in proptest::array::uniform4(-60i32..60),
+        ) {
+            let e: [f64; 4] = core::array::from_fn(|i| m[i] * 2f64.powi(scales[i]));
+            let (a, b) = (glam::DVec2::new(e[0], e[1]), glam::DVec2::new(e[2], e[3]));
+            let frobenius = a.length_squared() + b.length_squared();
+            let det = a.perp_dot(b);
+            let root = super::sqrt((frobenius * frobenius - 4.0 * det * det).max(0.0));
+            let inv = (frobenius + root) / (2.0 * det * det);
+            let by_products = if inv > 0.0 { inv } else { f64::INFINITY };
+            prop_assert_eq!(
+                super::inverse_square_smaller_singular_value(a, b).to_bits(),
+                by_products.to_bits()
+            );
         }
 
         /// `positive_finite` is `x > 0.0 && x < f64::INFINITY`, for any bits and at

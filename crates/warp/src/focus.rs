@@ -273,9 +273,9 @@ impl Focus {
 /// moved).
 fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, WarpError> {
     let dir = light_unit(light)?;
-    let (receivers, casters) = check_scene(scene)?;
+    let (receiver_box, caster_box) = check_scene(scene)?;
     // The vertices of the body alone: its planes are not needed here.
-    let body = ConvexBody::frustum_aabb_vertices(&view.frustum, &receivers)?;
+    let body = ConvexBody::frustum_aabb_vertices(&view.frustum, &receiver_box)?;
     if body.is_empty() {
         return Err(WarpError::NoVisibleReceivers);
     }
@@ -284,7 +284,11 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
     if !matrix_ok(&light_from_world) {
         return Err(WarpError::Degenerate);
     }
-    let receivers: ReceiverPoints = body.iter().map(|v| v.as_dvec3()).collect();
+    // Filled where they live (an array collected is then moved: a copy).
+    let mut receivers = ReceiverPoints::new();
+    for v in &body {
+        let _ = receivers.try_push(v.as_dvec3());
+    }
     // The receivers' light-space bounds: the caster prism's and the footprint's.
     let mut footprint = Bounds::EMPTY;
     let mut light_caster_scale = f64::MIN_POSITIVE;
@@ -293,7 +297,8 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
         footprint.add(q);
         light_caster_scale = light_caster_scale.max(q.abs().max_element());
     }
-    let casters = caster_points(&rot, &receivers, &footprint, &casters);
+    let mut casters = Points::new();
+    caster_points(&rot, &receivers, &footprint, &caster_box, &mut casters);
     // The casters start with the receivers.
     let mut light_bounds = footprint;
     for p in &casters[receivers.len()..] {
@@ -336,7 +341,7 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
 /// warp needs them and keeps them, so LiSPSM, XPSM and TSM from one body (or one
 /// warp at several strength scales) cast the probe rays once. That cache makes a
 /// body `Send` but not `Sync`: fit from one thread, or clone it per thread. The
-/// points are fixed-capacity arrays (no allocation), so a body is about 37 KB:
+/// points are fixed-capacity arrays (no allocation), so a body is about 28 KB:
 /// build it where it is used, or keep one per light, rather than moving it.
 /// The free functions ([`uniform_focused`](crate::uniform_focused),
 /// [`lispsm`](crate::lispsm), ...) build one and call these.
@@ -521,7 +526,8 @@ pub(crate) fn footprint_weight(b: &Bounds, scale: f64) -> f64 {
     if t.is_finite() { t } else { 0.0 }
 }
 
-/// The receivers' vertices plus the vertices of `caster box ∩ prism`, the prism being
+/// Writes to `out` (filled where it lives, not returned: an array moved is copied)
+/// the receivers' vertices plus the vertices of `caster box ∩ prism`, the prism being
 /// the receivers' light-space xy bounds extended along the light: every caster point
 /// that can shadow a visible receiver lies in that intersection, so the largest
 /// light-space `z` (toward the light) of these points bounds the casters that matter.
@@ -529,8 +535,17 @@ pub(crate) fn footprint_weight(b: &Bounds, scale: f64) -> f64 {
 /// (`ConvexBody::extruded_toward_light` of `shadowmap-frustum` is not used: its hull
 /// misses casters when the ray toward the light leaves the scene box through a side
 /// face.)
-fn caster_points(rot: &DMat4, receivers: &[DVec3], b: &Bounds, caster_box: &Aabb) -> Points {
-    let mut out: Points = receivers.iter().copied().collect();
+fn caster_points(
+    rot: &DMat4,
+    receivers: &[DVec3],
+    b: &Bounds,
+    caster_box: &Aabb,
+    out: &mut Points,
+) {
+    out.clear();
+    for p in receivers {
+        let _ = out.try_push(*p);
+    }
     let (lo, hi) = (caster_box.min.as_dvec3(), caster_box.max.as_dvec3());
     let scale = lo
         .abs()
@@ -559,7 +574,6 @@ fn caster_points(rot: &DMat4, receivers: &[DVec3], b: &Bounds, caster_box: &Aabb
             }
         }
     }
-    out
 }
 
 /// Axis-aligned bounds of points in `f64`.

@@ -5,6 +5,7 @@ use shadowmap_frustum::{Camera, ShadowTransform, math};
 
 use crate::WarpError;
 use crate::focus::{Bounds, Focus, FocusBody, View, finish, ortho_fit, smoothstep, sqrt0};
+use crate::predict::Fits;
 use crate::{MAX_WARP_RATIO, ParallelFade, SceneBounds};
 
 /// Options of [`lispsm`].
@@ -250,17 +251,29 @@ pub(crate) fn warp_fit(
     s: f64,
     reversed_z: bool,
 ) -> Result<(ShadowTransform, f64), WarpError> {
-    let (clip, s, scale) = warp_clip(f, view, s, reversed_z)?;
-    finish(f, clip, reversed_z, scale).map(|t| (t, s))
+    let fit = warp_clip(f, view, s, reversed_z)?;
+    finish(f, fit.clip_from_world, reversed_z, fit.world_scale).map(|t| (t, fit.s))
 }
 
-/// The `f64` `clip_from_world` of [`warp_fit`], the `s` used and the world scale.
+/// A fit of [`warp_clip`]: its `f64` clip matrices, the `s` used and the world
+/// scale.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct WarpClip {
+    pub(crate) clip_from_world: DMat4,
+    /// The same from the light frame (`Focus::rot`), which the error prediction
+    /// reads.
+    pub(crate) clip_from_light: DMat4,
+    pub(crate) s: f64,
+    pub(crate) world_scale: f64,
+}
+
+/// The fit of [`warp_fit`] before its `f32` output.
 pub(crate) fn warp_clip(
     f: &Focus,
     view: &View,
     s: f64,
     reversed_z: bool,
-) -> Result<(DMat4, f64, f64), WarpError> {
+) -> Result<WarpClip, WarpError> {
     let lb = &f.light_bounds;
     let scale = f.caster_scale;
     // A footprint too thin for f32 texels gets the widened uniform fit.
@@ -280,9 +293,17 @@ pub(crate) fn warp_clip(
     );
     let warp_from_world = warp * f.rot;
     // x, y and the far plane from the receivers; the near plane from the casters.
+    // At `s = 0` every `w` is exactly 1 and the divisions by it return their
+    // numerators: the uniform fit (and every warp's prediction at strength 0)
+    // skips them.
+    let affine = s == 0.0;
     let mut b = Bounds::EMPTY;
     for p in &f.receivers {
-        b.add(warp_from_world.project_point3(*p));
+        b.add(if affine {
+            warp_from_world.transform_point3(*p)
+        } else {
+            warp_from_world.project_point3(*p)
+        });
     }
     // The projected depth alone, as `project_point3` computes it.
     let m = &warp_from_world;
@@ -293,13 +314,19 @@ pub(crate) fn warp_clip(
     for p in &f.casters {
         let z = zr.x * p.x + zr.y * p.y + zr.z * p.z + zr.w;
         let w = wr.x * p.x + wr.y * p.y + wr.z * p.z + wr.w;
-        b.max.z = b.max.z.max(z / w);
+        b.max.z = b.max.z.max(if affine { z } else { z / w });
     }
     if b.is_empty() || !(b.min.is_finite() && b.max.is_finite()) {
         return Err(WarpError::Degenerate);
     }
     let b = turn_invariant(b, f, || warp_from_world).padded(scale, 1.0 - wide);
-    Ok((ortho_fit(&b, reversed_z) * warp_from_world, s, scale))
+    let clip_from_warp = ortho_fit(&b, reversed_z);
+    Ok(WarpClip {
+        clip_from_world: clip_from_warp * warp_from_world,
+        clip_from_light: clip_from_warp * warp,
+        s,
+        world_scale: scale,
+    })
 }
 
 /// Length of the light frame's raw axis
@@ -378,42 +405,46 @@ pub(crate) fn fit_chosen(
     reversed_z: bool,
 ) -> Result<(ShadowTransform, f64), WarpError> {
     let (f, view) = (&body.focus, &body.view);
-    match chosen_strength(body, s_formula, scale, reversed_z) {
-        Chosen {
-            fitted: Some((clip, s, world_scale)),
-            ..
-        } => finish(f, clip, reversed_z, world_scale).map(|t| (t, s)),
-        Chosen { s, .. } => warp_fit(f, view, s, reversed_z),
+    let mut fits = Fits::new();
+    let chosen = chosen_strength(body, s_formula, scale, reversed_z, &mut fits);
+    match chosen.kept.and_then(|t| fits.at(t)) {
+        Some(fit) => {
+            finish(f, fit.clip_from_world, reversed_z, fit.world_scale).map(|t| (t, fit.s))
+        }
+        None => warp_fit(f, view, chosen.s, reversed_z),
     }
 }
 
-/// A warp's chosen strength `s`, and [`warp_clip`]'s fit at it where the
-/// prediction made it.
+/// A warp's chosen strength `s`, and the prediction's `t` whose fit
+/// ([`warp_clip`]'s, in the prediction's [`Fits`]) is kept where it made one.
 struct Chosen {
     s: f64,
-    fitted: Option<(DMat4, f64, f64)>,
+    kept: Option<f64>,
 }
 
 /// The strength a warp of `body` fits at: [`predicted_strength`] for its formula's
 /// `s_formula`, scaled by `scale` ([`scaled_strength`]). At `scale` 0 that is the
 /// uniform fit whatever the prediction, so the prediction (most of a warp's cost) is
 /// skipped.
-fn chosen_strength(body: &FocusBody, s_formula: f64, scale: f32, reversed_z: bool) -> Chosen {
+fn chosen_strength(
+    body: &FocusBody,
+    s_formula: f64,
+    scale: f32,
+    reversed_z: bool,
+    fits: &mut Fits<WarpClip>,
+) -> Chosen {
     if scale <= 0.0 {
-        return Chosen {
-            s: 0.0,
-            fitted: None,
-        };
+        return Chosen { s: 0.0, kept: None };
     }
-    let (s, fitted) = predicted_strength(body, s_formula, reversed_z);
+    let (s, t) = predicted_strength(body, s_formula, reversed_z, fits);
     // A scale of 1 keeps `s` exactly (`scaled_strength`), and the prediction's fit
     // with it.
     if scale >= 1.0 {
-        Chosen { s, fitted }
+        Chosen { s, kept: t }
     } else {
         Chosen {
             s: scaled_strength(&body.focus, s, scale),
-            fitted: None,
+            kept: None,
         }
     }
 }
@@ -421,14 +452,15 @@ fn chosen_strength(body: &FocusBody, s_formula: f64, scale: f32, reversed_z: boo
 /// The strength to use for a warp whose formula asks for `s_formula`: the fraction
 /// of its warp ratio, `ln(1 + s d)`, of least predicted error on the body's probe
 /// (see [`Probe::strength`](crate::predict)), so that the fit degrades continuously
-/// to the uniform fit where the formula's warp does not pay; and [`warp_clip`]'s fit
-/// at it (depth as `reversed_z` asks: the prediction reads only the clip's `x`, `y`
-/// and `w`) where the prediction made it.
+/// to the uniform fit where the formula's warp does not pay; and the fraction `t`
+/// chosen, where the prediction ran (its [`warp_clip`] fits, depth as `reversed_z`
+/// asks, are in `fits`: the prediction reads only the clip's `x`, `y` and `w`).
 fn predicted_strength(
     body: &FocusBody,
     s_formula: f64,
     reversed_z: bool,
-) -> (f64, Option<(DMat4, f64, f64)>) {
+    fits: &mut Fits<WarpClip>,
+) -> (f64, Option<f64>) {
     if !(s_formula > 0.0) {
         return (0.0, None);
     }
@@ -446,339 +478,13 @@ fn predicted_strength(
             (math::exp(t * ln_r) - 1.0) / d
         }
     };
-    let (t, fitted) = body.probe().strength(
+    let t = body.probe().strength(
+        fits,
         |t| warp_clip(f, view, s_at(t), reversed_z).ok(),
-        |fit| &fit.0,
+        |fit| &fit.clip_from_light,
     );
-    (s_at(t), fitted)
+    (s_at(t), Some(t))
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
-    use glam::{DVec3, Vec3};
-    use shadowmap_frustum::{Aabb, Camera, Projection, ShadowMapping, ShadowTransform};
-
-    use super::*;
-    use crate::{UniformOptions, uniform_focused};
-
-    /// The overhead case: a camera 10 m up looking level along `-z` (fovY 60°,
-    /// n = 1, f = 1000) over receivers and casters that hold its whole frustum.
-    pub(crate) fn overhead_view() -> (Vec3, Camera, SceneBounds) {
-        let eye = Vec3::new(0.0, 10.0, 0.0);
-        let camera = Camera::look_to(
-            eye,
-            Vec3::NEG_Z,
-            Vec3::Y,
-            Projection::perspective(60f32.to_radians(), 1.0, 1.0, 1000.0),
-        )
-        .unwrap();
-        let scene = SceneBounds::whole(Aabb::new(
-            Vec3::new(-800.0, -800.0, -1100.0),
-            Vec3::new(800.0, 800.0, 10.0),
-        ));
-        (eye, camera, scene)
-    }
-
-    /// Texel density (texture units per world unit) along the view axis and across
-    /// it, at view depth `z`, by central differences.
-    fn density(t: &ShadowTransform, eye: DVec3, z: f64) -> (f64, f64) {
-        let p = eye + DVec3::new(0.0, 0.0, -z);
-        let h = 1e-4 * z;
-        let uv = |q: DVec3| t.map_point(q).unwrap().uv;
-        let along = (uv(p + DVec3::new(0.0, 0.0, -h)) - uv(p - DVec3::new(0.0, 0.0, -h))).length()
-            / (2.0 * h);
-        let across = (uv(p + DVec3::X * h) - uv(p - DVec3::X * h)).length() / (2.0 * h);
-        (along, across)
-    }
-
-    /// Storage factor of a fit for the overhead case (see `overhead_light_golden_ratios`).
-    fn storage_factor(
-        camera: &Camera,
-        light: Vec3,
-        scene: &SceneBounds,
-        eta: f32,
-        n: f64,
-        f: f64,
-        tan: f64,
-    ) -> f64 {
-        let t = lispsm(
-            camera,
-            light,
-            scene,
-            &LispsmOptions::default().with_eta(eta),
-        )
-        .unwrap()
-        .transform;
-        let eye = camera.eye().as_dvec3();
-        let (mut mx, mut my) = (0.0f64, 0.0f64);
-        for i in 0..=400 {
-            let z = n * (f / n).powf(f64::from(i) / 400.0);
-            let (along, across) = density(&t, eye, z);
-            mx = mx.max(1.0 / (2.0 * tan * z * across));
-            my = my.max(1.0 / (2.0 * tan * z * along));
-        }
-        let v = |z: f64| t.map_point(eye + DVec3::new(0.0, 0.0, -z)).unwrap().uv.y;
-        mx * my * (v(f) - v(n)).abs()
-    }
-
-    /// Overhead light, horizontal camera, n = 1, f = 1000, fovY = 60°: the near/far
-    /// density ratios are the closed forms of the 1-D analysis (Wimmer et al. 2004,
-    /// Lloyd et al. 2006): `r = 1 + s d` is 1 (uniform), `sqrt(f/n)` (LiSPSM) and
-    /// `f/n` (PSM); along the view the ratio is `r²`, across it `r`. The storage
-    /// factors are those of `docs/quality.md`: uniform `K (f - n) f / n²`, LiSPSM `K (f - n) / n`
-    /// (and PSM the same as LiSPSM in this separable 1-D measure).
-    #[test]
-    fn overhead_light_golden_ratios() {
-        let (n, f) = (1.0f32, 1000.0f32);
-        let eye = Vec3::new(0.0, 10.0, 0.0);
-        let camera = Camera::look_to(
-            eye,
-            Vec3::NEG_Z,
-            Vec3::Y,
-            Projection::perspective(60f32.to_radians(), 1.0, n, f),
-        )
-        .unwrap();
-        // Receivers and casters hold the whole frustum, so the body is the frustum.
-        let scene = SceneBounds::whole(Aabb::new(
-            Vec3::new(-800.0, -800.0, -1100.0),
-            Vec3::new(800.0, 800.0, 10.0),
-        ));
-        let light = Vec3::NEG_Y;
-        let ratio = |r: f64| (r * r, r);
-        let fo = f64::from(f / n);
-        let cases = [
-            (-1.0, ratio(1.0)),
-            (0.0, ratio(fo.sqrt())),
-            (1.0, ratio(fo)),
-        ];
-        for (eta, (want_along, want_across)) in cases {
-            let t = lispsm(
-                &camera,
-                light,
-                &scene,
-                &LispsmOptions::default().with_eta(eta),
-            )
-            .unwrap()
-            .transform;
-            let (a0, c0) = density(&t, eye.as_dvec3(), f64::from(n));
-            let (a1, c1) = density(&t, eye.as_dvec3(), f64::from(f));
-            let (along, across) = (a0 / a1, c0 / c1);
-            eprintln!(
-                "golden: eta {eta}: density ratio n/f along {along:.4} (closed form {want_along:.4}), across {across:.4} ({want_across:.4})"
-            );
-            assert!(
-                (along / want_along - 1.0).abs() < 0.02,
-                "eta {eta}: along {along} vs {want_along}"
-            );
-            assert!(
-                (across / want_across - 1.0).abs() < 0.02,
-                "eta {eta}: across {across} vs {want_across}"
-            );
-        }
-        // The storage factors of `docs/quality.md` from the measured densities (perspective-only,
-        // separable): S = max_z m_x(z) * max_z m_y(z) * (texels across the map) with
-        // m = (pixel density 1/(2 t z)) / (texel density), t = tan(fovY / 2).
-        let tan = (30f64).to_radians().tan();
-        let k = 1.0 / (2.0 * tan);
-        let (nf, ff) = (f64::from(n), f64::from(f));
-        for (eta, want) in [
-            (-1.0, k * (ff - nf) * ff / (nf * nf)),
-            (0.0, k * (ff - nf) / nf),
-            (1.0, k * (ff - nf) / nf),
-        ] {
-            let s = storage_factor(&camera, light, &scene, eta, nf, ff, tan);
-            eprintln!("golden: eta {eta}: storage factor S = {s:.4e} (closed form {want:.4e})");
-            assert!(
-                (s / want - 1.0).abs() < 0.02,
-                "eta {eta}: S = {s} vs {want}"
-            );
-        }
-        // n_opt = n + sqrt(n f).
-        let l = lispsm(&camera, light, &scene, &LispsmOptions::default()).unwrap();
-        let n_opt = 1.0 + 1000f32.sqrt();
-        assert!((l.n / n_opt - 1.0).abs() < 1e-3, "n = {} vs {n_opt}", l.n);
-        // The uniform fit is the eta = -1 fit.
-        let u = uniform_focused(&camera, light, &scene, &UniformOptions::default()).unwrap();
-        let (a0, _) = density(&u, eye.as_dvec3(), 1.0);
-        let (a1, _) = density(&u, eye.as_dvec3(), 1000.0);
-        assert!((a0 / a1 - 1.0).abs() < 1e-3);
-    }
-
-    /// `strength_scale` raises the chosen warp ratio to its power: over the overhead
-    /// case (warp ratio `sqrt(f / n)` across the view, its square along it), half
-    /// the scale gives the ratio's square root and none the uniform fit, for
-    /// LiSPSM, TSM and XPSM alike; a scale outside `[0, 1]` is refused.
-    #[test]
-    fn strength_scale_raises_the_warp_ratio_to_its_power() {
-        use crate::{TsmOptions, XpsmOptions, tsm, xpsm};
-        let (eye, camera, scene) = overhead_view();
-        let light = Vec3::NEG_Y;
-        // The warp ratio across the view between view depths 1 and 1000.
-        let across = |t: &ShadowTransform| {
-            let (near, far) = (
-                density(t, eye.as_dvec3(), 1.0),
-                density(t, eye.as_dvec3(), 1000.0),
-            );
-            near.1 / far.1
-        };
-        let fits = |scale: f32| {
-            [
-                lispsm(
-                    &camera,
-                    light,
-                    &scene,
-                    &LispsmOptions::default().with_strength_scale(scale),
-                )
-                .map(|s| s.transform),
-                tsm(
-                    &camera,
-                    light,
-                    &scene,
-                    &TsmOptions::default().with_strength_scale(scale),
-                )
-                .map(|s| s.transform),
-                xpsm(
-                    &camera,
-                    light,
-                    &scene,
-                    &XpsmOptions::default().with_strength_scale(scale),
-                )
-                .map(|s| s.transform),
-            ]
-        };
-        for ((full, half), none) in fits(1.0).iter().zip(fits(0.5)).zip(fits(0.0)) {
-            let (full, half, none) = (
-                across(full.as_ref().unwrap()),
-                across(&half.unwrap()),
-                across(&none.unwrap()),
-            );
-            assert!(full > 5.0, "{full}");
-            assert!((half / full.sqrt() - 1.0).abs() < 0.02, "{half} vs {full}");
-            assert!((none - 1.0).abs() < 1e-3, "{none}");
-        }
-        for scale in [-0.1, 1.5, f32::NAN] {
-            assert!(
-                fits(scale)
-                    .iter()
-                    .all(|f| matches!(f, Err(WarpError::InvalidOption)))
-            );
-        }
-        // The default is the full chosen strength.
-        assert_eq!(
-            fits(1.0)[0],
-            lispsm(&camera, light, &scene, &LispsmOptions::default()).map(|s| s.transform)
-        );
-    }
-
-    /// The prediction's own fit at the chosen strength, which the warp keeps
-    /// instead of fitting again, is the fit `warp_clip` makes at that strength (in
-    /// either depth convention: the prediction reads only clip `x`, `y` and `w`).
-    #[test]
-    fn the_predictions_fit_is_the_fit_at_the_chosen_strength() {
-        let (_, camera, scene) = overhead_view();
-        let mut kept = 0;
-        for light in [
-            Vec3::new(0.3, -1.0, 0.6),
-            Vec3::new(0.0, -0.3, -1.0),
-            Vec3::new(1.0, -0.2, 0.1),
-        ] {
-            let body = FocusBody::new(&camera, light, &scene).unwrap();
-            for reversed_z in [false, true] {
-                let o = LispsmOptions::default().with_reversed_z(reversed_z);
-                let (s, _) = warp_strength(&body.focus, &body.view, &o);
-                let chosen = chosen_strength(&body, s, 1.0, reversed_z);
-                let Some(fitted) = chosen.fitted else {
-                    continue;
-                };
-                let fresh = warp_clip(&body.focus, &body.view, chosen.s, reversed_z).unwrap();
-                assert_eq!(fitted, fresh, "{light} {reversed_z}");
-                kept += 1;
-            }
-        }
-        assert!(kept >= 2, "{kept}");
-    }
-
-    /// At scale 0 every strength scales to the uniform fit's, exactly: what lets
-    /// `chosen_strength` skip the prediction there.
-    #[test]
-    fn scale_zero_is_the_uniform_strength_whatever_the_prediction() {
-        let (_, camera, scene) = overhead_view();
-        for light in [
-            Vec3::NEG_Y,
-            Vec3::new(0.3, -1.0, 0.6),
-            Vec3::new(1.0, -0.05, 0.0),
-        ] {
-            let body = FocusBody::new(&camera, light, &scene).unwrap();
-            for s in [0.0, 1e-9, 0.01, 3.0, 1e12, f64::MAX] {
-                assert_eq!(scaled_strength(&body.focus, s, 0.0), 0.0, "{s}");
-            }
-            let o = LispsmOptions::default();
-            let (s, _) = warp_strength(&body.focus, &body.view, &o);
-            assert_eq!(chosen_strength(&body, s, 0.0, false).s, 0.0);
-        }
-    }
-
-    #[test]
-    fn options_out_of_range_are_refused() {
-        let camera = Camera::look_to(
-            Vec3::ZERO,
-            Vec3::NEG_Z,
-            Vec3::Y,
-            Projection::perspective(1.0, 1.0, 0.1, 10.0),
-        )
-        .unwrap();
-        let scene = SceneBounds::whole(Aabb::new(Vec3::splat(-20.0), Vec3::splat(20.0)));
-        for o in [
-            LispsmOptions::default().with_eta(1.5),
-            LispsmOptions::default().with_eta(f32::NAN),
-            LispsmOptions::default().with_fade(3.0, 10.0),
-            LispsmOptions::default().with_hints(-1.0, 10.0),
-            LispsmOptions::default().with_hints(5.0, 2.0),
-            LispsmOptions::default().with_hints(0.0, f32::NAN),
-        ] {
-            assert_eq!(
-                lispsm(&camera, Vec3::NEG_Y, &scene, &o).err(),
-                Some(WarpError::InvalidOption)
-            );
-        }
-        assert_eq!(
-            lispsm(&camera, Vec3::ZERO, &scene, &LispsmOptions::default()).err(),
-            Some(WarpError::ZeroDirection)
-        );
-        assert_eq!(
-            lispsm(
-                &camera,
-                Vec3::new(f32::NAN, 0.0, 0.0),
-                &scene,
-                &LispsmOptions::default()
-            )
-            .err(),
-            Some(WarpError::NonFinite)
-        );
-        let inverted = SceneBounds::new(Aabb::new(Vec3::ONE, Vec3::ZERO), scene.casters);
-        assert_eq!(
-            uniform_focused(&camera, Vec3::NEG_Y, &inverted, &UniformOptions::default()).err(),
-            Some(WarpError::EmptyReceivers)
-        );
-        let inverted = SceneBounds::new(scene.receivers, Aabb::new(Vec3::ONE, Vec3::ZERO));
-        assert_eq!(
-            uniform_focused(&camera, Vec3::NEG_Y, &inverted, &UniformOptions::default()).err(),
-            Some(WarpError::EmptyCasters)
-        );
-        let away = SceneBounds::whole(Aabb::new(Vec3::splat(100.0), Vec3::splat(101.0)));
-        assert_eq!(
-            uniform_focused(&camera, Vec3::NEG_Y, &away, &UniformOptions::default()).err(),
-            Some(WarpError::NoVisibleReceivers)
-        );
-        // Near/far hints narrow n_opt's depth range: a far hint strengthens the warp.
-        let base = lispsm(&camera, Vec3::NEG_Y, &scene, &LispsmOptions::default()).unwrap();
-        let hinted = lispsm(
-            &camera,
-            Vec3::NEG_Y,
-            &scene,
-            &LispsmOptions::default().with_hints(0.0, 2.0),
-        )
-        .unwrap();
-        assert!(hinted.n < base.n);
-    }
-}
+pub(crate) mod tests;

@@ -89,11 +89,16 @@ const MAX_POINTS: usize = RAYS * DEPTHS;
 /// Probe points stored by coordinate (one array per component of [`Point`]), so
 /// that [`points_error`]'s loop runs on several points at once (SIMD lanes), which
 /// an array of points does not let the compiler do.
+///
+/// The points and their screen steps are kept in the light frame
+/// ([`Focus::rot`](crate::focus::Focus)), `x` and `y` alone: a directional light's
+/// texel coordinates and `w` do not depend on the light-frame `z` (the depth along
+/// the light), so every fit's error reads those two (see [`points_error`]).
 #[derive(Clone, Debug, Default)]
 struct ProbePoints {
-    p: [ArrayVec<f64, MAX_POINTS>; 3],
-    dx: [ArrayVec<f64, MAX_POINTS>; 3],
-    dy: [ArrayVec<f64, MAX_POINTS>; 3],
+    p: [ArrayVec<f64, MAX_POINTS>; 2],
+    dx: [ArrayVec<f64, MAX_POINTS>; 2],
+    dy: [ArrayVec<f64, MAX_POINTS>; 2],
     weight: ArrayVec<f64, MAX_POINTS>,
     fade: ArrayVec<f64, MAX_POINTS>,
     /// The sum of `weight`, in the points' order (every error divides by it).
@@ -103,9 +108,9 @@ struct ProbePoints {
 impl ProbePoints {
     fn new() -> Self {
         Self {
-            p: [ArrayVec::new(), ArrayVec::new(), ArrayVec::new()],
-            dx: [ArrayVec::new(), ArrayVec::new(), ArrayVec::new()],
-            dy: [ArrayVec::new(), ArrayVec::new(), ArrayVec::new()],
+            p: [ArrayVec::new(), ArrayVec::new()],
+            dx: [ArrayVec::new(), ArrayVec::new()],
+            dy: [ArrayVec::new(), ArrayVec::new()],
             weight: ArrayVec::new(),
             fade: ArrayVec::new(),
             weight_sum: 0.0,
@@ -125,15 +130,21 @@ impl ProbePoints {
         self.weight_sum = 0.0;
     }
 
-    /// Adds `q` unless the set is full.
-    fn push(&mut self, q: &Point) {
+    /// Adds `q` (in the world) in the light frame `light_from_world` (a rotation:
+    /// its `x` and `y` rows), unless the set is full.
+    fn push(&mut self, q: &Point, light_from_world: &DMat4) {
         if self.weight.is_full() {
             return;
         }
-        for axis in 0..3 {
-            self.p[axis].push(q.p[axis]);
-            self.dx[axis].push(q.dx[axis]);
-            self.dy[axis].push(q.dy[axis]);
+        let m = light_from_world;
+        let rows = [
+            DVec3::new(m.x_axis.x, m.y_axis.x, m.z_axis.x),
+            DVec3::new(m.x_axis.y, m.y_axis.y, m.z_axis.y),
+        ];
+        for (axis, row) in rows.iter().enumerate() {
+            self.p[axis].push(row.dot(q.p));
+            self.dx[axis].push(row.dot(q.dx));
+            self.dy[axis].push(row.dot(q.dy));
         }
         self.weight.push(q.weight);
         self.fade.push(q.fade);
@@ -193,44 +204,45 @@ impl Probe {
 
     /// The fraction `t` in `[0, 1]` of a warp's formula strength to use, from its
     /// fit at a strength `t` (`None` where the fit fails) and that fit's clip
-    /// matrix: [`choose`] on the predicted error, blended by [`Probe::confidence`]
+    /// matrix from the light frame (`clip_from_light`, see [`points_error`]):
+    /// [`choose`] on the predicted error, blended by [`Probe::confidence`]
     /// with [`choose`] on the perspective-only error (every point facing the
     /// bisector of the eye and light directions). Where the receivers' box shows few
     /// front-lit faces (a light that grazes the ground, whose visible surfaces are
     /// then walls, fences and trunks the box does not have) the parameterization
     /// alone decides: falling back to the formula instead kept XPSM's length at a
     /// fence lit from 3° above the horizon, predicted 2x the uniform fit's error and
-    /// measured 1.57x. Each fit is made once for both errors, and the one at the
-    /// chosen `t` is returned where it was made (`t` one of the grid's, the usual
-    /// case: the formula's strength or the uniform fit), so the warp need not fit
-    /// it again.
+    /// measured 1.57x. Each fit is made once for both errors and kept in `fits`,
+    /// where the warp reads the one at the chosen `t` ([`Fits::at`]: `t` one of
+    /// the grid's, the usual case: the formula's strength or the uniform fit)
+    /// rather than fitting it again.
     pub(crate) fn strength<T>(
         &self,
+        fits: &mut Fits<T>,
         fit_at: impl FnMut(f64) -> Option<T>,
-        clip: impl Fn(&T) -> &DMat4,
-    ) -> (f64, Option<T>) {
-        self.strength_with(fit_at, clip, &self.perspective)
+        clip_from_light: impl Fn(&T) -> &DMat4,
+    ) -> f64 {
+        self.strength_with(fits, fit_at, clip_from_light, &self.perspective)
     }
 
     /// [`Probe::strength`] with the perspective set `perspective` (read only where
     /// the confidence is below 1).
     fn strength_with<T>(
         &self,
+        fits: &mut Fits<T>,
         mut fit_at: impl FnMut(f64) -> Option<T>,
-        clip: impl Fn(&T) -> &DMat4,
+        clip_from_light: impl Fn(&T) -> &DMat4,
         perspective: &ProbePoints,
-    ) -> (f64, Option<T>) {
+    ) -> f64 {
         let confidence = self.confidence();
-        let mut fits: [Option<Option<T>>; GRID] = [const { None }; GRID];
-        let grid_index = |t: f64| (math::round(t * (GRID - 1) as f64) as usize).min(GRID - 1);
         let mut error_at = |t: f64, points: &ProbePoints| {
-            fits[grid_index(t)]
-                .get_or_insert_with(|| fit_at(t))
-                .as_ref()
-                .map_or(f64::INFINITY, |fit| points_error(points, clip(fit)))
+            fits.get_or_make(grid_index(t), || fit_at(t))
+                .map_or(f64::INFINITY, |fit| {
+                    points_error(points, clip_from_light(fit))
+                })
         };
         let lit = (confidence > 0.0).then(|| choose(|t| error_at(t, &self.points)));
-        let t = match lit {
+        match lit {
             Some(t) if confidence >= 1.0 => t,
             _ => {
                 let perspective = choose(|t| error_at(t, perspective));
@@ -238,17 +250,7 @@ impl Probe {
                     perspective + (t - perspective) * confidence
                 })
             }
-        };
-        let i = grid_index(t);
-        let on_grid = t == i as f64 / (GRID - 1) as f64;
-        (
-            t,
-            if on_grid {
-                fits[i].take().flatten()
-            } else {
-                None
-            },
-        )
+        }
     }
 
     /// How far the prediction is to be trusted, in `[0, 1]`: 0 when no probe point
@@ -265,26 +267,32 @@ impl Probe {
     }
 }
 
-/// The power mean `E` of the aliasing error over `points` for `clip_from_world`
+/// The power mean `E` of the aliasing error over `points` for `clip_from_light`
 /// (see the module's documentation), infinite when a point falls behind the
 /// projection centre.
-fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
-    // Only clip x, y and w matter: the columns' (x, y, w), multiplied and summed
-    // in the order of the matrix product (a direction's zero `w` term left out).
-    let m = clip_from_world;
-    let [cx, cy, cz, cw] =
-        [m.x_axis, m.y_axis, m.z_axis, m.w_axis].map(|c| DVec3::new(c.x, c.y, c.w));
+///
+/// `clip_from_light` is a fit's clip matrix from the light frame, whose `x`, `y`
+/// and `w` rows do not read the light-frame `z` (true of every fit of a
+/// directional light: its `z` column reaches clip `z` alone); the points are in
+/// that frame ([`ProbePoints`]).
+fn points_error(points: &ProbePoints, clip_from_light: &DMat4) -> f64 {
+    // Only clip x, y and w matter: the columns' (x, y, w) of light-frame x, y and
+    // the translation, multiplied and summed in the order of the matrix product
+    // (a direction's zero `w` term left out).
+    let m = clip_from_light;
+    debug_assert!(m.z_axis.x == 0.0 && m.z_axis.y == 0.0 && m.z_axis.w == 0.0);
+    let [cx, cy, cw] = [m.x_axis, m.y_axis, m.w_axis].map(|c| DVec3::new(c.x, c.y, c.w));
     let n = points.len().min(MAX_POINTS);
-    let [px, py, pz] = points.p.each_ref().map(|c| &c[..n]);
-    let [dxx, dxy, dxz] = points.dx.each_ref().map(|c| &c[..n]);
-    let [dyx, dyy, dyz] = points.dy.each_ref().map(|c| &c[..n]);
+    let [px, py] = points.p.each_ref().map(|c| &c[..n]);
+    let [dxx, dxy] = points.dx.each_ref().map(|c| &c[..n]);
+    let [dyx, dyy] = points.dy.each_ref().map(|c| &c[..n]);
     let (weight, fade) = (&points.weight[..n], &points.fade[..n]);
     // Each point's term first, with no branch, so the loop runs on several points
     // at once; then their sum.
     let mut terms = [0.0; MAX_POINTS];
     let mut behind = false;
-    let dx = |i: usize| DVec3::new(dxx[i], dxy[i], dxz[i]);
-    let dy = |i: usize| DVec3::new(dyx[i], dyy[i], dyz[i]);
+    let dx = |i: usize| DVec2::new(dxx[i], dxy[i]);
+    let dy = |i: usize| DVec2::new(dyx[i], dyy[i]);
     // The term of point `i` from `1 / s²` of its screen steps' moves in ndc.
     let term = |i: usize, inv_s2: f64| {
         (
@@ -292,12 +300,12 @@ fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
             !(inv_s2 < f64::INFINITY),
         )
     };
-    if cx.z == 0.0 && cy.z == 0.0 && cz.z == 0.0 && cw.z == 1.0 {
+    if cx.z == 0.0 && cy.z == 0.0 && cw.z == 1.0 {
         // An affine clip (every orthographic fit: a warp at strength 0) moves ndc
         // by its x and y rows alone: `w = 1` and `dw = 0` exactly, so the general
         // form below gives the same values, without the point's own `h` and `w⁴`.
-        let ndc = |d: DVec3| {
-            let dh = cx * d.x + cy * d.y + cz * d.z;
+        let ndc = |d: DVec2| {
+            let dh = cx * d.x + cy * d.y;
             DVec2::new(dh.x, dh.y)
         };
         for (i, slot) in terms[..n].iter_mut().enumerate() {
@@ -308,12 +316,12 @@ fn points_error(points: &ProbePoints, clip_from_world: &DMat4) -> f64 {
         }
     } else {
         for (i, slot) in terms[..n].iter_mut().enumerate() {
-            let h = cx * px[i] + cy * py[i] + cz * pz[i] + cw;
+            let h = cx * px[i] + cy * py[i] + cw;
             let hw = h.z;
             // A move in ndc is `(dh.xy w - h.xy dh.w) / w²`: its `1 / s²` is that
             // of the numerators times `w⁴` (one division a point, not five).
-            let moved = |d: DVec3| {
-                let dh = cx * d.x + cy * d.y + cz * d.z;
+            let moved = |d: DVec2| {
+                let dh = cx * d.x + cy * d.y;
                 DVec2::new(dh.x, dh.y) * hw - DVec2::new(h.x, h.y) * dh.z
             };
             let w2 = hw * hw;
@@ -357,6 +365,46 @@ fn pow4(x: f64) -> f64 {
 /// Strengths at which a warp is evaluated, as fractions of its formula's warp in
 /// `ln(1 + s d)` (0: the uniform fit, 1: the formula's).
 const GRID: usize = 5;
+
+/// The grid strength nearest `t` (by index).
+fn grid_index(t: f64) -> usize {
+    (math::round(t * (GRID - 1) as f64) as usize).min(GRID - 1)
+}
+
+/// The fits a warp's strength choice made ([`Probe::strength`]), one per grid
+/// strength at most (`None` where the fit failed), held by the warp: the fit it
+/// keeps is read where it was made, not moved out (a fit is a few hundred bytes;
+/// the fixed-capacity list is not initialized, where an array of them would be).
+pub(crate) struct Fits<T>(ArrayVec<(usize, Option<T>), GRID>);
+
+impl<T> Fits<T> {
+    /// No fits yet.
+    pub(crate) const fn new() -> Self {
+        Self(ArrayVec::new_const())
+    }
+
+    /// The fit at grid strength `index`, made by `make` unless it was made before.
+    fn get_or_make(&mut self, index: usize, make: impl FnOnce() -> Option<T>) -> Option<&T> {
+        let slot = match self.0.iter().position(|(i, _)| *i == index) {
+            Some(slot) => slot,
+            None => {
+                // One fit per grid strength: never full.
+                self.0.try_push((index, make())).ok()?;
+                self.0.len() - 1
+            }
+        };
+        self.0.get(slot)?.1.as_ref()
+    }
+
+    /// The fit made at `t`, where `t` is a grid strength the choice fitted at and
+    /// the fit succeeded.
+    pub(crate) fn at(&self, t: f64) -> Option<&T> {
+        let index = grid_index(t);
+        let on_grid = t == index as f64 / (GRID - 1) as f64;
+        let (_, fit) = self.0.iter().find(|(i, _)| on_grid && *i == index)?;
+        fit.as_ref()
+    }
+}
 
 /// Predicted error of full warp over the uniform fit's below which the formula's
 /// strength is kept as it is.

@@ -2,12 +2,13 @@
 
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec3, DVec4, Vec3};
-use shadowmap_frustum::{Camera, MAX_FRUSTUM_AABB_VERTICES, ShadowTransform};
+use shadowmap_frustum::{Camera, ShadowTransform};
 
 use crate::FocusBody;
 use crate::WarpError;
 use crate::focus::{Bounds, Focus, ReceiverPoints, View, finish, scale_of, smoothstep};
 use crate::lispsm::{scaled_strength, turn_invariant};
+use crate::predict::Fits;
 use shadowmap_frustum::math;
 
 /// Options of [`xpsm`].
@@ -275,22 +276,26 @@ fn xpsm_body(body: &FocusBody, options: &XpsmOptions) -> Result<XpsmShadow, Warp
         None => auto_length(f, view, weight),
     };
     let space = XpsmSpace::new(view, f, options, shift);
-    // The automatic length after the prediction, and the prediction's fit with it
-    // where it made one (scaled to 0 below whatever the prediction: skipped).
+    // The automatic length after the prediction, and the prediction's `t` where it
+    // ran (scaled to 0 below whatever the prediction: skipped).
+    let mut fits = Fits::new();
     let (length_p, predicted) = if options.coef.is_none() && options.strength_scale > 0.0 {
-        predicted_length(body, &space, options, length_p)
+        predicted_length(body, &space, options, length_p, &mut fits)
     } else {
         (length_p, None)
     };
-    // A scale of 1 keeps the length exactly (`scaled_strength`), and so the fit.
-    let fit = match predicted {
+    // A scale of 1 keeps the length exactly (`scaled_strength`), and so the
+    // prediction's fit at it, where it made one.
+    let fresh;
+    let fit = match predicted.and_then(|t| fits.at(t)) {
         Some(fit) if options.strength_scale >= 1.0 => fit,
         _ => {
             let length_p = scaled_strength(f, length_p, options.strength_scale);
-            xpsm_fit(&space, f, options, length_p)?
+            fresh = xpsm_fit(&space, f, options, length_p)?;
+            &fresh
         }
     };
-    let transform = finish(f, fit.clip, options.reversed_z, fit.world_scale)?;
+    let transform = finish(f, fit.clip(&space), options.reversed_z, fit.world_scale)?;
     // The lookup is evaluated at the receivers: the matrix must resolve them too (a
     // depth range spanning absurdly tall casters can leave it singular there).
     if !shadowmap_frustum::is_invertible(&transform.clip_from_world, f.receiver_scale as f32) {
@@ -317,13 +322,14 @@ fn xpsm_body(body: &FocusBody, options: &XpsmOptions) -> Result<XpsmShadow, Warp
 /// camera looking down or toward the light, a body reaching far behind the viewer,
 /// or a projection vector clipped at the back-projection singularity (step 7),
 /// which magnifies the receivers nearest the singularity and starves the rest.
-/// Also the prediction's fit at that length, where it made one.
+/// Also the fraction `t` chosen, where the prediction ran (its fits in `fits`).
 fn predicted_length(
     body: &FocusBody,
     space: &XpsmSpace,
     options: &XpsmOptions,
     length: f64,
-) -> (f64, Option<XpsmFit>) {
+    fits: &mut Fits<XpsmFit>,
+) -> (f64, Option<f64>) {
     let f = &body.focus;
     let (y0, y1) = f.warp_axis_range();
     let d = (y1 - y0).max(0.0);
@@ -341,21 +347,34 @@ fn predicted_length(
             (math::exp(t * ln_r) - 1.0) / d
         }
     };
-    let (t, fit) = body
-        .probe()
-        .strength(|t| xpsm_fit(space, f, options, at(t)).ok(), |fit| &fit.clip);
-    (at(t), fit)
+    let t = body.probe().strength(
+        fits,
+        |t| xpsm_fit(space, f, options, at(t)).ok(),
+        |fit| &fit.clip_from_light,
+    );
+    (at(t), Some(t))
 }
 
-/// The fitted matrices of steps 1 and 4-17 for a given `lengthP`.
+/// The fitted matrices of steps 4-17 for a given `lengthP`.
 struct XpsmFit {
-    clip: DMat4,
+    /// Step 17 before its product with light space (`XpsmSpace::light_space`).
+    clip_from_light_space: DMat4,
+    /// The same from the light frame (`Focus::rot`), which the error prediction
+    /// reads.
+    clip_from_light: DMat4,
     world_scale: f64,
     /// `MaxZ - MinZ`.
     z_extent: f64,
     /// `lengthP` after the clip of step 7 and the precision guards.
     length_p: f64,
     max_length_p: f64,
+}
+
+impl XpsmFit {
+    /// Step 17: the fit's `clip_from_world` in `space`.
+    fn clip(&self, space: &XpsmSpace) -> DMat4 {
+        self.clip_from_light_space * space.light_space
+    }
 }
 
 /// What the fits of one XPSM call share, whatever their `lengthP` (step 1, the
@@ -443,7 +462,7 @@ fn xpsm_fit(
     mut length_p: f64,
 ) -> Result<XpsmFit, WarpError> {
     let eps_w = f64::from(options.epsilon_w);
-    let (light_space, unit_p) = (space.light_space, UNIT_P);
+    let light_space = space.light_space;
     let (receivers, casters) = (&space.receivers, &space.casters);
     let (max_proj, max_length_p, world_scale) =
         (space.max_proj, space.max_length_p, space.world_scale);
@@ -462,31 +481,15 @@ fn xpsm_fit(
     if !(length_p.is_finite() && length_p >= 0.0) {
         length_p = 0.0;
     }
-    // Steps 8-10: Projection * ZRotation (column-vector form): X = P.xy, Y = P.xy
-    // rotated, w = 1 + lengthP (P.xy).
-    // The paper's ZRotation (rows (Px, Py), (Py, -Px)) is a reflection, right for
-    // D3D's left-handed frame; here the rotation (Px, Py), (-Py, Px) keeps the winding.
-    let rot_z = DMat4::from_cols(
-        DVec4::new(unit_p.x, -unit_p.y, 0.0, 0.0),
-        DVec4::new(unit_p.y, unit_p.x, 0.0, 0.0),
-        DVec4::new(0.0, 0.0, 1.0, 0.0),
-        DVec4::W,
-    );
-    let projection = DMat4::from_cols(
-        DVec4::new(1.0, 0.0, 0.0, unit_p.x * length_p),
-        DVec4::new(0.0, 1.0, 0.0, unit_p.y * length_p),
-        DVec4::new(0.0, 0.0, 1.0, 0.0),
-        DVec4::W,
-    );
-    // ZRotation maps unit P to +X (row 1 of the paper's ZRotation); w is unchanged.
-    let ppls = rot_z * projection;
+    // Steps 8-10: post-perspective light space (PPLS).
+    let ppls = Ppls { length_p };
     // Step 11: transform into PPLS, clipping by w >= epsilonW.
     // The points that set maxLengthP land on w = epsilonW itself: classify with a
     // relative margin so rounding cannot drop them.
     let eps_clip = eps_w * (1.0 - 1e-9);
     // Step 12: boxes.
-    let cbox = clipped_bounds(&ppls, casters, eps_clip);
-    let rbox = clipped_bounds(&ppls, receivers, eps_clip);
+    let cbox = clipped_bounds(ppls, casters, eps_clip);
+    let rbox = clipped_bounds(ppls, receivers, eps_clip);
     let (Some((cxy, cz)), Some((rxy, rz))) = (cbox, rbox) else {
         return Err(WarpError::EmptyFocusRegion);
     };
@@ -514,7 +517,8 @@ fn xpsm_fit(
     region.max.z = cz.1.max(rz.1);
     // Near the light frame's two zeros the region must not depend on how the frame
     // is turned (see `turn_invariant`).
-    let region = turn_invariant(region, f, || ppls * light_space);
+    let ppls_from_light_space = ppls.matrix();
+    let region = turn_invariant(region, f, || ppls_from_light_space * light_space);
     // Widen a thin region as the uniform fit does: relative to the focus body's
     // coordinates, where the lookup is evaluated, not to the far corners of the
     // caster box (which would make the miner's-lamp fit coarser than the uniform
@@ -553,10 +557,20 @@ fn xpsm_fit(
             DVec4::new(-1.0, -1.0, 1.0, 1.0),
         )
     };
-    // Step 17: the final transformation (View * LightSpace folded into light_space).
-    let clip = normalized * unit_cube * ppls * light_space;
+    // Step 17 (its product with light space made for the fit kept: `XpsmFit::clip`).
+    let clip_from_light_space = normalized * unit_cube * ppls_from_light_space;
+    // Light space is the light frame (`Focus::rot`) moved by its translation: the
+    // product with that translation keeps the first three columns.
+    let m = &clip_from_light_space;
+    let clip_from_light = DMat4::from_cols(
+        m.x_axis,
+        m.y_axis,
+        m.z_axis,
+        *m * light_space.w_axis.truncate().extend(1.0),
+    );
     Ok(XpsmFit {
-        clip,
+        clip_from_light_space,
+        clip_from_light,
         world_scale,
         z_extent: ext.z,
         length_p,
@@ -624,33 +638,80 @@ fn auto_length(f: &Focus, view: &View, weight: f64) -> (f64, f64) {
     (s, y0 - y_eye)
 }
 
+/// Steps 8-10 for the projection length `lengthP`: post-perspective light space
+/// (PPLS) from light space, `Projection * ZRotation` of the paper in column-vector
+/// form: `X = P.xy`, `Y = P.xy` rotated a quarter turn, `w = 1 + lengthP (P.xy)`.
+#[derive(Clone, Copy)]
+struct Ppls {
+    length_p: f64,
+}
+
+impl Ppls {
+    /// The matrix, for unit P of any direction.
+    ///
+    /// The paper's ZRotation (rows (Px, Py), (Py, -Px)) is a reflection, right for
+    /// D3D's left-handed frame; here the rotation (Px, Py), (-Py, Px) keeps the
+    /// winding. ZRotation maps unit P to `+X` (row 1 of the paper's ZRotation); `w`
+    /// is unchanged.
+    fn matrix(self) -> DMat4 {
+        let (unit_p, length_p) = (UNIT_P, self.length_p);
+        let rot_z = DMat4::from_cols(
+            DVec4::new(unit_p.x, -unit_p.y, 0.0, 0.0),
+            DVec4::new(unit_p.y, unit_p.x, 0.0, 0.0),
+            DVec4::new(0.0, 0.0, 1.0, 0.0),
+            DVec4::W,
+        );
+        let projection = DMat4::from_cols(
+            DVec4::new(1.0, 0.0, 0.0, unit_p.x * length_p),
+            DVec4::new(0.0, 1.0, 0.0, unit_p.y * length_p),
+            DVec4::new(0.0, 0.0, 1.0, 0.0),
+            DVec4::W,
+        );
+        rot_z * projection
+    }
+
+    /// `matrix() * p.extend(1.0)` for unit P along `+Y` ([`UNIT_P`]):
+    /// `(y, -x, z, 1 + lengthP y)`, the product's values (its other terms have a
+    /// zero factor) in four operations rather than twenty-eight.
+    fn hom(self, p: DVec3) -> Hom {
+        DVec4::new(p.y, -p.x, p.z, 1.0 + self.length_p * p.y)
+    }
+}
+
 /// The xy box and the z range of the PPLS points of a vertex set split by the plane
 /// `w = eps_w`: every vertex (those behind, `w < eps_w`, with `w` raised to `eps_w`
 /// for the xy box and left out of the z range), plus the crossing of every segment
 /// between a vertex in front and one behind (a superset of the clipped hull's
 /// vertices). `None` when no vertex has `w >= eps_w`. The points are bounded as they
 /// are made, never stored.
-fn clipped_bounds(ppls: &DMat4, points: &[DVec3], eps_w: f64) -> Option<(Bounds, (f64, f64))> {
-    // Filled where it lives (a collected array is moved, a kilobyte a call); as
-    // many as the focus body's receivers (the caster box has 8 corners).
-    let mut hom: ArrayVec<Hom, MAX_FRUSTUM_AABB_VERTICES> = ArrayVec::new();
-    for p in points.iter().take(hom.capacity()) {
-        hom.push(*ppls * p.extend(1.0));
-    }
+fn clipped_bounds(ppls: Ppls, points: &[DVec3], eps_w: f64) -> Option<(Bounds, (f64, f64))> {
     let mut acc = CloudBounds::EMPTY;
+    if ppls.length_p == 0.0 {
+        // Every `w` is 1, above `eps_w` (below 1): nothing to clip, and the
+        // divisions by `w` would return their numerators.
+        for p in points {
+            let h = ppls.hom(*p);
+            acc.xy.add(DVec3::new(h.x, h.y, 0.0));
+            acc.z = (acc.z.0.min(h.z), acc.z.1.max(h.z));
+        }
+        acc.any = !points.is_empty();
+        return acc.finish();
+    }
     let mut behind = false;
-    for h in &hom {
-        acc.add(*h, eps_w);
+    for p in points {
+        let h = ppls.hom(*p);
+        acc.add(h, eps_w);
         behind |= h.w < eps_w;
     }
     if !behind {
         // Nothing to clip (the usual case): no pair to visit.
         return acc.finish();
     }
-    for a in hom.iter().filter(|h| h.w >= eps_w) {
-        for b in hom.iter().filter(|h| h.w < eps_w) {
+    let hom = || points.iter().map(|p| ppls.hom(*p));
+    for a in hom().filter(|h| h.w >= eps_w) {
+        for b in hom().filter(|h| h.w < eps_w) {
             let t = (a.w - eps_w) / (a.w - b.w);
-            let mut c = *a + (*b - *a) * t;
+            let mut c = a + (b - a) * t;
             c.w = eps_w;
             acc.add(c, eps_w);
         }

@@ -4,7 +4,7 @@
 //! point moves on its surface for one step on the screen.
 
 use arrayvec::ArrayVec;
-use glam::{DVec2, DVec3};
+use glam::{DMat4, DVec2, DVec3};
 use shadowmap_frustum::math::{self, max_num, min_num};
 
 use super::{COLUMNS, DEPTHS, Point, ProbePoints, RAYS, ROWS};
@@ -28,12 +28,13 @@ pub(super) struct Ray {
 }
 
 /// What a probe's rays are cast from: the screen, the receivers' box, the screen
-/// step and the light.
+/// step, the light and the light frame the points are kept in.
 pub(super) struct Rays {
     screen: Screen,
     receivers: Bounds,
     step: DVec2,
     light: DVec3,
+    light_from_world: DMat4,
 }
 
 impl Rays {
@@ -57,11 +58,12 @@ impl Rays {
             receivers,
             step,
             light: f.light,
+            light_from_world: f.rot,
         }
     }
 
-    /// Adds the points of `pass` of every ray to `out`, row by row; returns the sum
-    /// of the rays' weights.
+    /// Adds the points of `pass` of every ray to `out`, row by row, in the light
+    /// frame; returns the sum of the rays' weights.
     pub(super) fn cast(&self, pass: Pass, out: &mut ProbePoints) -> f64 {
         let columns: [Column; COLUMNS] = core::array::from_fn(|column| {
             self.screen.column((column as f64 + 0.5) / COLUMNS as f64)
@@ -93,7 +95,7 @@ impl Rays {
         for plan in &planned {
             let ray = &rays[plan.ray];
             if let Some(q) = point_at(ray, self.step, plan.s, plan.n, plan.weight, plan.fade) {
-                out.push(&q);
+                out.push(&q, &self.light_from_world);
             }
         }
         geometric

@@ -20,12 +20,15 @@ fn probe(lit: f64) -> (Probe, Vec<Point>) {
         perspective.push(q);
         if lit > 0.0 {
             // ... and down y on the lit faces.
-            probe.points.push(&Point {
-                weight: lit,
-                dx: DVec3::new(1.0, 0.0, 0.0),
-                dy: DVec3::new(0.0, 1e-3, 0.0),
-                ..q
-            });
+            probe.points.push(
+                &Point {
+                    weight: lit,
+                    dx: DVec3::new(1.0, 0.0, 0.0),
+                    dy: DVec3::new(0.0, 1e-3, 0.0),
+                    ..q
+                },
+                &DMat4::IDENTITY,
+            );
         }
         probe.geometric += 1.0;
     }
@@ -39,9 +42,9 @@ fn strength(
 ) -> f64 {
     let mut points = ProbePoints::new();
     for q in perspective {
-        points.push(q);
+        points.push(q, &DMat4::IDENTITY);
     }
-    probe.strength_with(clip, |c| c, &points).0
+    probe.strength_with(&mut Fits::new(), clip, |c| c, &points)
 }
 
 /// With no front-lit face the strength is the one of least perspective-only
@@ -135,43 +138,62 @@ fn error_by_definition(points: &[Point], clip_from_world: &DMat4) -> f64 {
 
 proptest::proptest! {
     /// `points_error` (the Jacobian's `1 / s²` from the numerators of the
-    /// quotient rule times `w⁴`, the terms summed four at a time) is the error of
-    /// its definition to rounding, for perspective clips (a LiSPSM-like warp of
-    /// any strength along any axis) and affine ones.
+    /// quotient rule times `w⁴`, the terms summed four at a time, on the points'
+    /// light-frame `x` and `y`) is the error of its definition on the world points
+    /// to rounding, for perspective clips (a LiSPSM-like warp of any strength
+    /// along any axis across the light) and affine ones, in a light frame of any
+    /// direction.
     #[test]
     fn the_error_is_its_definition(
         seed in proptest::collection::vec(-1.0f64..1.0, 7 * 23),
         strength in 0.0f64..2.0,
-        axis in proptest::sample::select(vec![DVec3::X, DVec3::Y, DVec3::new(0.6, 0.0, 0.8)]),
+        axis in proptest::sample::select(vec![DVec3::X, DVec3::Y, DVec3::new(0.6, 0.8, 0.0)]),
         n in 1usize..23,
+        light in proptest::array::uniform3(-1.0f64..1.0),
+        turn in 0.0f64..6.3,
     ) {
+        // A light frame: `z` against the light, turned about it by `turn`.
+        let z = DVec3::from(light).try_normalize().unwrap_or(DVec3::Z);
+        let x = z.any_orthonormal_vector();
+        let x = x * turn.cos() + z.cross(x) * turn.sin();
+        let rot = DMat4::from_cols(
+            x.extend(0.0),
+            z.cross(x).extend(0.0),
+            z.extend(0.0),
+            glam::DVec4::W,
+        )
+        .transpose();
+        // The points made in the light frame (their steps well apart across the
+        // light, whatever its direction), then turned to the world.
+        let world = |v: DVec3| rot.transpose().transform_vector3(v);
         let points: Vec<Point> = seed
             .chunks_exact(7)
             .take(n)
             .map(|c| Point {
-                p: DVec3::new(c[0], c[1], c[2]) * 5.0,
-                dx: DVec3::new(1e-3, c[3] * 1e-3, 0.0),
-                dy: DVec3::new(c[4] * 1e-3, 1e-3, c[5] * 1e-4),
+                p: world(DVec3::new(c[0], c[1], c[2]) * 5.0),
+                dx: world(DVec3::new(1e-3, c[3] * 1e-3, c[5] * 1e-3)),
+                dy: world(DVec3::new(c[4] * 1e-3, 1e-3, c[5] * 1e-4)),
                 weight: 0.5 + 0.5 * c[6].abs(),
                 fade: 0.2 + 0.8 * c[6].abs(),
             })
             .collect();
         let mut probe = ProbePoints::new();
         for q in &points {
-            probe.push(q);
+            probe.push(q, &rot);
         }
         // A depth along `axis` of 3.5 to 17.5 divides x and y:
-        // `w = 1 + s (axis·p + 10.5)`, `|axis·p| <= 7`.
+        // `w = 1 + s (axis·p + 10.5)`, `|axis·p| <= 7`; x, y and w do not read
+        // the light-frame z.
         let w_row = (axis * strength).extend(1.0 + 10.5 * strength);
         let clip = DMat4::from_cols_array_2d(&[
             [0.1, 0.02, 0.0, w_row.x],
             [-0.03, 0.12, 0.0, w_row.y],
-            [0.01, 0.0, 0.05, w_row.z],
+            [0.0, 0.0, 0.05, 0.0],
             [0.2, -0.1, 0.5, w_row.w],
         ]);
-        for m in [clip, DMat4::from_scale(DVec3::new(0.1, 0.07, 0.05))] {
-            let fast = points_error(&probe, &m);
-            let reference = error_by_definition(&points, &m);
+        for clip_from_light in [clip, DMat4::from_scale(DVec3::new(0.1, 0.07, 0.05))] {
+            let fast = points_error(&probe, &clip_from_light);
+            let reference = error_by_definition(&points, &(clip_from_light * rot));
             proptest::prop_assert!(
                 (fast - reference).abs() <= 1e-12 * reference,
                 "{fast} vs {reference}"

@@ -110,3 +110,17 @@ fn the_warp_ratio_fades_as_a_power_of_the_weight() {
     }
     assert!((last - 50.0).abs() < 1e-9);
 }
+
+proptest::proptest! {
+    /// The PPLS point made without the matrix is the matrix's product, value for
+    /// value, whatever the length (0 included: the orthographic fit).
+    #[test]
+    fn the_ppls_point_is_the_matrix_product(
+        p in proptest::array::uniform3(-1e4f64..1e4),
+        length_p in proptest::prop_oneof![proptest::strategy::Just(0.0), 0.0f64..10.0],
+    ) {
+        let ppls = Ppls { length_p };
+        let p = DVec3::from(p);
+        proptest::prop_assert_eq!(ppls.hom(p), ppls.matrix() * p.extend(1.0));
+    }
+}
