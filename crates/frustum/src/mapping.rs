@@ -88,6 +88,40 @@ pub fn projective_uv_differentials(
     centre: DVec3,
     around: &[DVec3; 4],
 ) -> Option<[DVec2; 2]> {
+    let m = uv_from_world;
+    if !bounded(m, centre, around) {
+        mapped_uv_differentials(m, centre, around)
+    } else if m.x_axis.w == 0.0 && m.y_axis.w == 0.0 && m.z_axis.w == 0.0 && m.w_axis.w == 1.0 {
+        Some(affine_uv_differentials(m, around))
+    } else {
+        perspective_uv_differentials(m, centre, around)
+    }
+}
+
+/// Entries and coordinates at most this large: a product of a matrix row and a
+/// point is at most `4e200`, finite.
+const PRODUCT_BOUND: f64 = 1e100;
+
+/// Whether the entries of `m` and the points are within [`PRODUCT_BOUND`] (a NaN
+/// is not).
+fn bounded(m: &DMat4, centre: DVec3, around: &[DVec3; 4]) -> bool {
+    let bound = glam::DVec4::splat(PRODUCT_BOUND);
+    let within = |v: glam::DVec4| v.abs().cmple(bound).all();
+    [m.x_axis, m.y_axis, m.z_axis, m.w_axis]
+        .into_iter()
+        .all(within)
+        && core::iter::once(&centre)
+            .chain(around)
+            .all(|p| within(p.extend(0.0)))
+}
+
+/// [`projective_uv_differentials`] in general: the points mapped for their
+/// coverage (`w > 0` and finite), the derivative at `centre`.
+fn mapped_uv_differentials(
+    uv_from_world: &DMat4,
+    centre: DVec3,
+    around: &[DVec3; 4],
+) -> Option<[DVec2; 2]> {
     let covered = |h: glam::DVec4| h.w > 0.0 && h.is_finite();
     let h = *uv_from_world * centre.extend(1.0);
     if !covered(h)
@@ -97,13 +131,51 @@ pub fn projective_uv_differentials(
     {
         return None;
     }
+    Some(derivative_at(uv_from_world, h, around))
+}
+
+/// [`projective_uv_differentials`] of an affine map (last row exactly `(0, 0, 0,
+/// 1)`: the orthographic maps of the uniform fit and the cascades) for entries and
+/// points within [`PRODUCT_BOUND`]: every point is covered (`w` is exactly 1 and
+/// every product finite), and the derivative is the map's `x` and `y` rows applied
+/// to the half-differences (the general form's `uv dw` is a zero and its `1 / w`
+/// is 1: the same values, up to the sign of a zero).
+fn affine_uv_differentials(m: &DMat4, around: &[DVec3; 4]) -> [DVec2; 2] {
+    let column = |a: DVec3, b: DVec3| {
+        let dh = *m * ((a - b) * 0.5).extend(0.0);
+        DVec2::new(dh.x, dh.y)
+    };
+    [column(around[0], around[1]), column(around[2], around[3])]
+}
+
+/// [`projective_uv_differentials`] of a perspective map for entries and points
+/// within [`PRODUCT_BOUND`]: every product is finite, so a point is covered where
+/// its `w` is positive, and the four points around need their `w` alone (computed
+/// as the product computes it); the centre is mapped.
+#[inline(never)]
+fn perspective_uv_differentials(
+    m: &DMat4,
+    centre: DVec3,
+    around: &[DVec3; 4],
+) -> Option<[DVec2; 2]> {
+    let w_of = |p: DVec3| m.x_axis.w * p.x + m.y_axis.w * p.y + m.z_axis.w * p.z + m.w_axis.w;
+    let h = *m * centre.extend(1.0);
+    if !(h.w > 0.0 && around.iter().all(|p| w_of(*p) > 0.0)) {
+        return None;
+    }
+    Some(derivative_at(m, h, around))
+}
+
+/// The derivative of `uv_from_world` at a covered centre it maps to `h`, applied to
+/// the half-differences of the two pairs of points `around`.
+fn derivative_at(uv_from_world: &DMat4, h: glam::DVec4, around: &[DVec3; 4]) -> [DVec2; 2] {
     let inv_w = 1.0 / h.w;
     let uv = DVec2::new(h.x, h.y) * inv_w;
     let column = |a: DVec3, b: DVec3| {
         let dh = *uv_from_world * ((a - b) * 0.5).extend(0.0);
         (DVec2::new(dh.x, dh.y) - uv * dh.w) * inv_w
     };
-    Some([column(around[0], around[1]), column(around[2], around[3])])
+    [column(around[0], around[1]), column(around[2], around[3])]
 }
 
 /// Which way is "toward the light" for depth bias.
@@ -351,6 +423,41 @@ mod tests {
 
     proptest! {
         #![proptest_config(shadowmap_testgen::proptest_config())]
+
+        /// The shortcuts of `projective_uv_differentials` for bounded entries and
+        /// points give the general form's values and coverage, for affine maps
+        /// and perspective ones (points in front of and behind the projection
+        /// centre).
+        #[test]
+        fn the_bounded_shortcuts_are_the_mapped_form(
+            rows in proptest::array::uniform12(-1.0f64..1.0),
+            scale in -6.0f64..6.0,
+            points in proptest::array::uniform15(-1.0f64..1.0),
+            reach in -3.0f64..6.0,
+            w_row in proptest::array::uniform4(-1.0f64..1.0),
+            perspective in any::<bool>(),
+        ) {
+            let k = magnitude(scale);
+            let r = magnitude(reach);
+            // A perspective row `w = 1.5 w_3 + row · p / r`: points on both sides.
+            let w = if perspective {
+                [w_row[0] / r, w_row[1] / r, w_row[2] / r, 1.5 * w_row[3]]
+            } else {
+                [0.0, 0.0, 0.0, 1.0]
+            };
+            let m = glam::DMat4::from_cols_array(&[
+                rows[0] * k, rows[1] * k, rows[2] * k, w[0],
+                rows[3] * k, rows[4] * k, rows[5] * k, w[1],
+                rows[6] * k, rows[7] * k, rows[8] * k, w[2],
+                rows[9] * k, rows[10] * k, rows[11] * k, w[3],
+            ]);
+            let p = |i: usize| DVec3::new(points[3 * i], points[3 * i + 1], points[3 * i + 2]) * r;
+            let (centre, around) = (p(0), [p(1), p(2), p(3), p(4)]);
+            prop_assert!(super::bounded(&m, centre, &around));
+            let fast = super::projective_uv_differentials(&m, centre, &around);
+            prop_assert_eq!(fast, super::mapped_uv_differentials(&m, centre, &around));
+            prop_assert!(perspective || fast.is_some());
+        }
 
         /// Where `ortho_rotation_invertible` is certain, `is_invertible` agrees at
         /// that world scale and above; and an ordinary fit is decided without it.

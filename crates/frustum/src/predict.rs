@@ -303,14 +303,18 @@ impl Pass<'_> {
                 }
                 // Where the neighbouring pixels' rays meet each point's plane: the
                 // same for every candidate, computed once.
-                let steps = hit.map(|point, normal| self.screen.pixel_steps(at, point, normal));
+                let pixel_rays = self.screen.pixel_rays(at);
+                let mut steps = [None; DEPTH_POINTS];
+                hit.map(&mut steps, |point, normal| {
+                    pixel_steps(&pixel_rays, point, normal)
+                });
                 // Every candidate's differentials at the hit's points first, then
                 // the errors: their square roots and divisions (most of a
                 // candidate's time) run side by side, not each after its
                 // candidate's matrix products.
                 let mut differentials = [[None; DEPTH_POINTS]; MAX_PREDICT_CANDIDATES];
                 for (d, &(mapping, side)) in differentials.iter_mut().zip(candidates) {
-                    *d = hit.map_with(&steps, |point, steps| {
+                    hit.map_with(&steps, d, |point, steps| {
                         texel_differentials(point, steps.as_ref()?, mapping, f64::from(side))
                     });
                 }
@@ -359,19 +363,20 @@ impl Hit {
         }
     }
 
-    /// `f(point, normal)` for each of the hit's points (one for a face).
-    fn map<T: Copy + Default>(&self, mut f: impl FnMut(DVec3, DVec3) -> T) -> [T; DEPTH_POINTS] {
-        self.map_with(&[self.normal(); DEPTH_POINTS], |p, n| f(p, *n))
+    /// `f(point, normal)` for each of the hit's points (one for a face), written
+    /// to `out` (filled where it lives: the caller's arrays are not moved).
+    fn map<T>(&self, out: &mut [T; DEPTH_POINTS], mut f: impl FnMut(DVec3, DVec3) -> T) {
+        self.map_with(&[self.normal(); DEPTH_POINTS], out, |p, n| f(p, *n));
     }
 
     /// `f(point, data)` for each of the hit's points, `data` the point's entry of
-    /// `per_point` ([`Hit::map`]).
-    fn map_with<T, U: Copy + Default>(
+    /// `per_point`, written to `out` ([`Hit::map`]).
+    fn map_with<T, U>(
         &self,
         per_point: &[T; DEPTH_POINTS],
+        out: &mut [U; DEPTH_POINTS],
         mut f: impl FnMut(DVec3, &T) -> U,
-    ) -> [U; DEPTH_POINTS] {
-        let mut out = [U::default(); DEPTH_POINTS];
+    ) {
         match self {
             Self::Face(p, _) => out[0] = f(*p, &per_point[0]),
             Self::Range(points, _) => {
@@ -380,7 +385,6 @@ impl Hit {
                 }
             }
         }
-        out
     }
 
     /// The error of the ray from `error_at(point, data)`, `data` the point's entry
@@ -523,22 +527,40 @@ impl Screen {
         Some(Hit::Range(points, normal))
     }
 
-    /// Where the rays one pixel away from `at` (`+x`, `-x`, `+y`, `-y`) meet the
-    /// plane through `point` with `normal`; `None` if one runs parallel to it.
-    fn pixel_steps(&self, at: DVec2, point: DVec3, normal: DVec3) -> Option<PixelSteps> {
-        let mut steps = [DVec3::ZERO; 4];
-        for (i, step) in steps.iter_mut().enumerate() {
-            let (axis, sign) = (i / 2, if i % 2 == 0 { 1.0 } else { -1.0 });
-            let mut offset = DVec2::ZERO;
-            offset[axis] = self.pixel[axis];
-            let (o, d) = self.ray(at + offset * sign);
-            *step = plane_hit(o, d, point, normal)?;
-        }
-        Some(steps)
+    /// The rays one pixel away from `at` (`+x`, `-x`, `+y`, `-y`), as
+    /// [`Screen::ray`] makes them (the two across `y` share their edge points at
+    /// `at.x`, computed once).
+    fn pixel_rays(&self, at: DVec2) -> [(DVec3, DVec3); 4] {
+        let edges = |x: f64| {
+            let edge = |q: &[DVec3; 4]| (q[0].lerp(q[1], x), q[3].lerp(q[2], x));
+            (edge(&self.near), edge(&self.far))
+        };
+        let ray_at = |(near, far): ((DVec3, DVec3), (DVec3, DVec3)), y: f64| {
+            let origin = near.0.lerp(near.1, y);
+            (origin, far.0.lerp(far.1, y) - origin)
+        };
+        let (dx, dy) = (self.pixel.x, self.pixel.y);
+        let column = edges(at.x);
+        [
+            ray_at(edges(at.x + dx), at.y),
+            ray_at(edges(at.x - dx), at.y),
+            ray_at(column, at.y + dy),
+            ray_at(column, at.y - dy),
+        ]
     }
 }
 
-/// The points one pixel away on a probe point's plane ([`Screen::pixel_steps`]).
+/// Where the rays one pixel away from a ray ([`Screen::pixel_rays`]) meet the plane
+/// through `point` with `normal`; `None` if one runs parallel to it.
+fn pixel_steps(rays: &[(DVec3, DVec3); 4], point: DVec3, normal: DVec3) -> Option<PixelSteps> {
+    let mut steps = [DVec3::ZERO; 4];
+    for (step, &(o, d)) in steps.iter_mut().zip(rays) {
+        *step = plane_hit(o, d, point, normal)?;
+    }
+    Some(steps)
+}
+
+/// The points one pixel away on a probe point's plane ([`pixel_steps`]).
 type PixelSteps = [DVec3; 4];
 
 /// The map's differentials in texels at `point` for the neighbouring pixels'
