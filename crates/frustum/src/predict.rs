@@ -484,13 +484,17 @@ impl Screen {
     /// The ray through normalized screen position `at` (`(0, 0)` bottom left): the
     /// point on the near plane and the step to the far plane.
     fn ray(&self, at: DVec2) -> (DVec3, DVec3) {
-        let bilerp = |q: &[DVec3; 4]| {
-            let bottom = q[0].lerp(q[1], at.x);
-            let top = q[3].lerp(q[2], at.x);
-            bottom.lerp(top, at.y)
-        };
-        let origin = bilerp(&self.near);
-        (origin, bilerp(&self.far) - origin)
+        self.column(at.x).ray(at.y)
+    }
+
+    /// The near and far faces' bottom and top edge points at screen `x`, which
+    /// every ray at that `x` interpolates.
+    fn column(&self, x: f64) -> Column {
+        let edge = |q: &[DVec3; 4]| (q[0].lerp(q[1], x), q[3].lerp(q[2], x));
+        Column {
+            near: edge(&self.near),
+            far: edge(&self.far),
+        }
     }
 
     /// Where the ray through `at` first meets the box inside the visible depth
@@ -531,22 +535,30 @@ impl Screen {
     /// [`Screen::ray`] makes them (the two across `y` share their edge points at
     /// `at.x`, computed once).
     fn pixel_rays(&self, at: DVec2) -> [(DVec3, DVec3); 4] {
-        let edges = |x: f64| {
-            let edge = |q: &[DVec3; 4]| (q[0].lerp(q[1], x), q[3].lerp(q[2], x));
-            (edge(&self.near), edge(&self.far))
-        };
-        let ray_at = |(near, far): ((DVec3, DVec3), (DVec3, DVec3)), y: f64| {
-            let origin = near.0.lerp(near.1, y);
-            (origin, far.0.lerp(far.1, y) - origin)
-        };
         let (dx, dy) = (self.pixel.x, self.pixel.y);
-        let column = edges(at.x);
+        let column = self.column(at.x);
         [
-            ray_at(edges(at.x + dx), at.y),
-            ray_at(edges(at.x - dx), at.y),
-            ray_at(column, at.y + dy),
-            ray_at(column, at.y - dy),
+            self.column(at.x + dx).ray(at.y),
+            self.column(at.x - dx).ray(at.y),
+            column.ray(at.y + dy),
+            column.ray(at.y - dy),
         ]
+    }
+}
+
+/// A screen column's edge points ([`Screen::column`]): `(bottom, top)` on the near
+/// and on the far face.
+struct Column {
+    near: (DVec3, DVec3),
+    far: (DVec3, DVec3),
+}
+
+impl Column {
+    /// The ray at screen height `y`: the point on the near plane and the step to
+    /// the far plane.
+    fn ray(&self, y: f64) -> (DVec3, DVec3) {
+        let origin = self.near.0.lerp(self.near.1, y);
+        (origin, self.far.0.lerp(self.far.1, y) - origin)
     }
 }
 
