@@ -5,11 +5,11 @@
 //! error; it never panics.
 
 use arbitrary::Unstructured;
-use glam::{Mat4, Vec3};
+use glam::{DVec2, DVec3, Mat4, Vec3};
 use shadowmap_frustum::{
     Aabb, Camera, Cascade, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState,
-    ConvexBody, DepthBounds, Frustum, Light, SceneBounds, SplitScheme, ValidCamera,
-    directional_light_from_world, fit_spot,
+    ConvexBody, DepthBounds, Frustum, Light, SceneBounds, ShadowMapping, ShadowSample,
+    ShadowTransform, SplitScheme, ValidCamera, directional_light_from_world, fit_spot,
 };
 
 /// The crate these generators build values of. `shadowmap-frustum`'s own unit tests
@@ -460,7 +460,10 @@ pub fn spot_case_raw(u: &mut Unstructured<'_>) -> GenResult<SpotCase> {
     })
 }
 
-/// Spot fit: accepted fits have finite invertible matrices and `near < far`.
+/// Spot fit: accepted fits have finite invertible matrices and `near < far`; where
+/// the window is narrower than the cone on both axes, each visible receiver point
+/// the map stores (frustum ∩ receivers: its vertices) lands on the same texel, to
+/// `f32` rounding, as the point halfway to the light on its ray.
 pub fn check_spot(case: &SpotCase) {
     let Ok(frustum) = case.camera.frustum() else {
         return;
@@ -471,6 +474,53 @@ pub fn check_spot(case: &SpotCase) {
     assert_invertible(&spot.transform.clip_from_world, "spot clip_from_world");
     assert!(spot.light_depth.0 > 0.0 && spot.light_depth.1 > spot.light_depth.0);
     assert!(spot.tangents.iter().all(|t| t.is_finite()));
+    let Light::Spot {
+        position,
+        half_angle,
+        ..
+    } = case.light
+    else {
+        return;
+    };
+    // A window as wide as the cone may be finer than f32 resolves near the light:
+    // nothing wider is lit.
+    let cone = 2.0 * f64::from(half_angle).tan() * (1.0 - 1e-6);
+    let [l, r, b, t] = spot.tangents.map(f64::from);
+    if r - l >= cone || t - b >= cone {
+        return;
+    }
+    let body = case
+        .scene
+        .map(|s| ConvexBody::from_frustum_aabb(&frustum, &s.receivers));
+    let points = match &body {
+        Some(Ok(body)) => body.vertices(),
+        Some(Err(_)) => return,
+        None => &frustum.corners,
+    };
+    for p in points {
+        if let Some(gap) = ray_gap(&spot.transform, position.as_dvec3(), p.as_dvec3()) {
+            let scale = p.abs().max_element().max(position.abs().max_element());
+            let tol = 1e-4 + 1e-6 * f64::from(scale) / (*p - position).length() as f64;
+            assert!(
+                gap <= tol,
+                "{p}: its ray's texels {gap} apart (tolerance {tol})"
+            );
+        }
+    }
+}
+
+/// How far apart (largest `uv` difference) `map` stores `p` and the point halfway
+/// from `light` to `p`, when it stores both inside the map with a depth in
+/// `[0, 1]`.
+pub fn ray_gap(map: &ShadowTransform, light: DVec3, p: DVec3) -> Option<f64> {
+    let inside = |s: &ShadowSample| {
+        s.uv.cmpge(DVec2::ZERO).all()
+            && s.uv.cmple(DVec2::ONE).all()
+            && (0.0..=1.0).contains(&s.depth)
+    };
+    let far = map.map_point(p).filter(inside)?;
+    let halfway = map.map_point(light + (p - light) * 0.5).filter(inside)?;
+    Some((far.uv - halfway.uv).abs().max_element())
 }
 
 /// Input of [`check_depth_bounds`].

@@ -38,12 +38,18 @@
 //! at least 10% better than it;
 //! so the warp fades to the spot fit where it does not pay (the view along the
 //! light's rays, a room seen from inside).
+//!
+//! A warp magnifies the map near its projection centre, and with it the rounding of
+//! its `f32` matrix, which a point near the light divides by its small `w`: the
+//! strength is limited to what keeps the two ends of every light ray through the
+//! visible receivers within a tenth of a texel of a `1024²` map apart (a light far
+//! from the origin, receivers a hair from it).
 
 use arrayvec::ArrayVec;
-use glam::{DMat4, DVec2, DVec4, Mat4, Vec2};
+use glam::{DMat4, DVec2, DVec4, Mat4, Vec2, Vec3};
 use shadowmap_frustum::{
-    Camera, DepthBounds, Light, PredictOptions, SceneBounds, ShadowMapping, ShadowTransform,
-    SpotShadow, fit_spot, math, predict_errors,
+    Camera, DepthBounds, Light, LightDirection, PredictOptions, SceneBounds, ShadowMapping,
+    ShadowTransform, SpotShadow, fit_spot, math, predict_errors,
 };
 
 use crate::{MAX_WARP_RATIO, WarpError};
@@ -163,6 +169,14 @@ pub fn spot_warp(
         SpotWarpKind::Lispsm => window.lispsm_strength(&line),
         SpotWarpKind::Tsm => window.tsm_strength(&line, f64::from(options.focus)),
     };
+    let LightDirection::Position(position) = base.transform.light else {
+        return Ok(keep);
+    };
+    let formula = window.resolved(
+        formula,
+        &Rounding::new(&base, position),
+        base.transform.reversed_z,
+    );
     // The formula's warp, weaker ones, the spot fit turned to the centre line.
     let strengths = [1.0, 0.5, 0.25, 0.125, 0.0].map(|k| k * formula);
     let mut candidates: ArrayVec<ShadowTransform, 6> = ArrayVec::new();
@@ -360,8 +374,57 @@ impl Window {
         }
     }
 
+    /// The strongest strength up to `sigma` whose warped map `f32` resolves at the
+    /// receivers: within [`ROUNDING_BUDGET`] by `rounding`'s bound, found by
+    /// bisection on its logarithm (to a millionth of it); 0 when even a millionth of
+    /// `sigma` does not resolve.
+    fn resolved(&self, sigma: f64, rounding: &Rounding, reversed_z: bool) -> f64 {
+        let resolves = |sigma: f64| {
+            self.warp(sigma, reversed_z)
+                .is_ok_and(|warp| rounding.bound(&warp) <= ROUNDING_BUDGET)
+        };
+        if !(sigma > 0.0) || resolves(sigma) {
+            return sigma;
+        }
+        // A warp 1e-6 times as strong is the spot fit turned, to rounding.
+        let (mut weak, mut strong) = (
+            math::ln(sigma) - 6.0 * core::f64::consts::LN_10,
+            math::ln(sigma),
+        );
+        if !resolves(math::exp(weak)) {
+            return 0.0;
+        }
+        for _ in 0..24 {
+            let middle = 0.5 * (weak + strong);
+            if resolves(math::exp(middle)) {
+                weak = middle;
+            } else {
+                strong = middle;
+            }
+        }
+        math::exp(weak)
+    }
+
     /// The warp of strength `sigma` after the spot fit (see the module docs).
     fn transform(&self, base: &SpotShadow, sigma: f64) -> Result<ShadowTransform, WarpError> {
+        let warp = self.warp(sigma, base.transform.reversed_z)?;
+        let clip = warp * base.transform.clip_from_world.as_dmat4();
+        let clip_from_world: Mat4 = clip.as_mat4();
+        let det = clip_from_world.as_dmat4().determinant();
+        if !clip_from_world.is_finite() || !det.is_finite() || det == 0.0 {
+            return Err(WarpError::Degenerate);
+        }
+        Ok(ShadowTransform::new(
+            base.transform.light_from_world,
+            clip_from_world,
+            base.transform.reversed_z,
+            base.transform.light,
+        ))
+    }
+
+    /// The warp of strength `sigma`, from the spot fit's clip coordinates to the
+    /// warped map's (see the module docs).
+    fn warp(&self, sigma: f64, reversed_z: bool) -> Result<DMat4, WarpError> {
         let (d, e, t0, l) = (self.along, self.across, self.t0, self.length);
         let q = |c: DVec2| 1.0 + sigma * (c.dot(d) - t0);
         let a = CORNERS.map(|c| c.dot(e) / q(c));
@@ -381,24 +444,54 @@ impl Window {
         // `depth' = far + (depth - far) / q`. Perspective depth crowds toward the far
         // value, so the `1 / q` across the map barely tilts it (a depth `depth / q`
         // would slope by `1 / q`'s gradient and take the slope-scaled bias with it).
-        let z = if base.transform.reversed_z {
+        let z = if reversed_z {
             DVec4::new(0.0, 0.0, 1.0, 0.0)
         } else {
             r_w + DVec4::new(0.0, 0.0, 1.0, -1.0)
         };
-        let warp = DMat4::from_cols(x, y, z, r_w).transpose();
-        let clip = warp * base.transform.clip_from_world.as_dmat4();
-        let clip_from_world: Mat4 = clip.as_mat4();
-        let det = clip_from_world.as_dmat4().determinant();
-        if !clip_from_world.is_finite() || !det.is_finite() || det == 0.0 {
-            return Err(WarpError::Degenerate);
+        Ok(DMat4::from_cols(x, y, z, r_w).transpose())
+    }
+}
+
+/// The most `f32` rounding may separate the two ends of a light ray at a receiver
+/// of a warped map, in device units: a tenth of a texel of a `1024²` map.
+const ROUNDING_BUDGET: f64 = 0.2 / 1024.0;
+
+/// How far the rounding of the `f32` matrices separates the two ends of one light
+/// ray in the spot fit warped by a matrix `W`, at the visible receivers.
+///
+/// In exact arithmetic the warped map's `x`, `y` and `w` rows all vanish at the
+/// light's position: every light ray is one line through it. The `f32` matrix
+/// `round(W C)` (`C` the spot fit's `f32` matrix, itself rounded) leaves there an
+/// error `e`, computed here exactly, which a point at `w` carries as `e / w`: the
+/// nearer the light, the larger, so the two ends of a ray land on different texels.
+/// Inside the map `q ≥ 1`, so `w` is at least the distance along the spot's axis,
+/// and `|x / w| ≤ 1`: a receiver's device coordinates move by at most
+/// `(|e_x| + |e_w|) / nearest` (likewise `y`).
+struct Rounding {
+    /// The spot fit's matrix `C`.
+    base: DMat4,
+    /// The light's position, `(light, 1)`.
+    light: DVec4,
+    /// The nearest receivers' distance along the spot's axis.
+    nearest: f64,
+}
+
+impl Rounding {
+    fn new(base: &SpotShadow, light: Vec3) -> Self {
+        Self {
+            base: base.transform.clip_from_world.as_dmat4(),
+            light: light.as_dvec3().extend(1.0),
+            nearest: f64::from(base.receiver_depth.0),
         }
-        Ok(ShadowTransform::new(
-            base.transform.light_from_world,
-            clip_from_world,
-            base.transform.reversed_z,
-            base.transform.light,
-        ))
+    }
+
+    /// The bound, in device units, for the warp `warp` (clip from the spot fit's
+    /// clip coordinates), read off the `f32` matrix [`Window::transform`] stores.
+    fn bound(&self, warp: &DMat4) -> f64 {
+        let stored = (*warp * self.base).as_mat4().as_dmat4();
+        let e = (stored * self.light).abs();
+        (e.x.max(e.y) + e.w) / self.nearest
     }
 }
 

@@ -16,6 +16,57 @@ proptest! {
     }
 }
 
+/// A spot 7 from the origin with receivers 1.3 mm from it (the camera at the
+/// light): LiSPSM's formula asks for a warp f32 cannot hold there (ray ends 2e-4
+/// apart in the map, the depth along a ray reversed); the strength is limited to
+/// what it resolves, and the warp keeps what the spot fit stores.
+#[test]
+fn a_warp_f32_cannot_hold_near_the_light_is_weakened() {
+    use glam::{Mat4, Vec3, Vec4};
+    use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds};
+    use shadowmap_testgen::spot_warp::SpotWarpCase;
+    use shadowmap_warp::{SpotWarpKind, SpotWarpOptions, spot_warp};
+    let position = Vec3::new(-3.1845953, -4.4273043, -3.9811594);
+    let receivers = Aabb::new(
+        Vec3::new(-3.191339, -4.4266453, -4.048091),
+        Vec3::new(-3.138978, -4.3395076, -3.981229),
+    );
+    let case = SpotWarpCase {
+        light: Light::Spot {
+            position,
+            direction: Vec3::new(0.2509941, 0.8505368, -0.462157),
+            half_angle: 1.2852015,
+            range: 0.060552612,
+        },
+        camera: Camera {
+            world_from_view: Mat4::from_cols(
+                Vec4::new(-0.9590938, 0.28308836, 0.0, 0.0),
+                Vec4::new(-0.13082929, -0.4432452, -0.8868018, 0.0),
+                Vec4::new(-0.25104326, -0.8505261, 0.46214998, 0.0),
+                Vec4::new(-3.1845973, -4.4273043, -3.9811594, 1.0),
+            ),
+            projection: Projection::perspective(0.8516727, 0.6407938, 0.0011615366, 0.07743174),
+            reversed_z: false,
+        },
+        bounds: None,
+        scene: SceneBounds::new(receivers, receivers),
+        options: SpotWarpOptions::default()
+            .with_kind(SpotWarpKind::Lispsm)
+            .with_focus(0.01),
+    };
+    let checked = check_spot_warp(&case).unwrap();
+    assert!(checked > 0);
+    let fit = spot_warp(
+        &case.light,
+        &case.camera,
+        case.bounds,
+        &case.scene,
+        &case.options,
+    )
+    .unwrap();
+    assert!(fit.strength < 1.0, "strength {}", fit.strength);
+}
+
 /// The generator reaches fitted warps with points to check, warped and not.
 #[test]
 fn the_generator_reaches_warped_fits() {

@@ -1,0 +1,129 @@
+//! The spot fit's window against `f32` rounding: a window finer than `f32` resolves
+//! is widened (both ends of a light ray then land on one texel), one that `f32`
+//! resolves is kept as fitted.
+
+use glam::{DVec3, Mat4, Vec3, Vec4};
+use shadowmap_frustum::{Aabb, Camera, ConvexBody, Light, Projection, SceneBounds, fit_spot};
+use shadowmap_testgen::frustum::ray_gap;
+
+/// The body's vertices and the midpoints of every pair of them.
+fn region_points(body: &ConvexBody) -> Vec<DVec3> {
+    let v = body.vertices();
+    let mut points: Vec<DVec3> = v.iter().map(|p| p.as_dvec3()).collect();
+    for (i, a) in v.iter().enumerate() {
+        points.extend(v[i + 1..].iter().map(|b| ((*a + *b) * 0.5).as_dvec3()));
+    }
+    points
+}
+
+/// A spot 0.05 from the origin lighting, from its own position along the view, a
+/// receiver slab 1.7e-7 thick and 3 mm away: the receivers' window is 1.5e-5 wide
+/// at them, 300 f32 steps of the coordinates, and put the two ends of a ray 0.37
+/// texels of a 1024² map apart.
+#[test]
+fn a_window_finer_than_f32_resolves_is_widened() {
+    let position = Vec3::new(-0.045266125, 0.026110286, -0.023142785);
+    let light = Light::Spot {
+        position,
+        direction: Vec3::new(-1.1336593e-5, 6.613013e-6, 1.0),
+        half_angle: 0.05,
+        range: 0.01,
+    };
+    let camera = Camera {
+        world_from_view: Mat4::from_cols(
+            Vec4::new(0.0, 1.0, -6.8421896e-6, 0.0),
+            Vec4::new(1.0, 8.236331e-11, 1.2037566e-5, 0.0),
+            Vec4::new(1.2037566e-5, -6.8421896e-6, -1.0, 0.0),
+            position.extend(1.0),
+        ),
+        projection: Projection::perspective(0.55297774, 0.0100592915, 0.0010011252, 0.0029421665),
+        reversed_z: false,
+    };
+    let receivers = Aabb::new(
+        Vec3::new(-0.04610102, 0.026101908, -0.022141663),
+        Vec3::new(-0.044431303, 0.026102075, -0.020200608),
+    );
+    let frustum = camera.frustum().unwrap();
+    let scene = SceneBounds::new(receivers, receivers);
+    let spot = fit_spot(&light, &frustum, Some(&scene), false).unwrap();
+
+    let body = ConvexBody::from_frustum_aabb(&frustum, &receivers).unwrap();
+    let points = region_points(&body);
+    let reach = points
+        .iter()
+        .fold(f64::from(position.abs().max_element()), |m, p| {
+            m.max(p.abs().max_element())
+        });
+    let [l, r, b, t] = spot.tangents.map(f64::from);
+    let nearest = f64::from(spot.receiver_depth.0);
+    for width in [r - l, t - b] {
+        assert!(width * nearest >= 2e-3 * reach * (1.0 - 1e-5), "{width}");
+    }
+    let mut checked = 0;
+    for p in points {
+        if let Some(gap) = ray_gap(&spot.transform, position.as_dvec3(), p) {
+            assert!(gap <= 1e-4, "{p}: the ray's ends {gap} apart");
+            checked += 1;
+        }
+    }
+    assert!(checked > 0);
+}
+
+/// A street-lamp spot over a ground plane: the window `f32` resolves is the
+/// receivers' own, each side the smallest and largest tangent of the visible region.
+#[test]
+fn a_window_f32_resolves_is_kept() {
+    let camera = Camera::look_to(
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::new(0.3, -0.2, -1.0),
+        Vec3::Y,
+        Projection::perspective(1.0, 1.6, 0.1, 200.0),
+    )
+    .unwrap();
+    let position = Vec3::new(10.0, 17.0, -5.0);
+    let light = Light::Spot {
+        position,
+        direction: Vec3::new(-0.4, -1.0, -0.6).normalize(),
+        half_angle: 0.9,
+        range: 200.0,
+    };
+    let ground = Aabb::new(Vec3::new(-60.0, -1.0, -80.0), Vec3::new(60.0, 0.0, 10.0));
+    let frustum = camera.frustum().unwrap();
+    let spot = fit_spot(
+        &light,
+        &frustum,
+        Some(&SceneBounds::new(ground, ground)),
+        false,
+    )
+    .unwrap();
+    let body = ConvexBody::from_frustum_aabb(&frustum, &ground).unwrap();
+    let light_from_world = spot.transform.light_from_world.as_dmat4();
+    let cone = f64::from(0.9f32.tan());
+    let mut expected = [
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for v in body.vertices() {
+        let q = light_from_world.transform_point3(v.as_dvec3());
+        let (x, y) = (q.x / -q.z, q.y / -q.z);
+        expected = [
+            expected[0].min(x),
+            expected[1].max(x),
+            expected[2].min(y),
+            expected[3].max(y),
+        ];
+    }
+    let expected = expected.map(|t| t.clamp(-cone, cone));
+    for (got, want) in spot.tangents.iter().zip(expected) {
+        assert!(
+            (f64::from(*got) - want).abs() <= 1e-5 * want.abs().max(1.0),
+            "{got} {want}"
+        );
+    }
+    assert!(
+        expected.iter().any(|t| t.abs() < cone),
+        "the window is the cone's"
+    );
+}
