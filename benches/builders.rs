@@ -1,8 +1,9 @@
 //! Every per-frame builder timed in one run, beside our transcription of Bevy's
 //! per-frame directional cascade math (`benches/support/bevy_like.rs`, shared with
 //! `cascades_vs_bevy`): uniform focused, stable and tight 4-cascade fits, LiSPSM,
-//! XPSM, TSM, four warped cascades, the spot fit, the IPSM plan with the paper's and
-//! the exact cone, RTW warp tables from a 1-D importance, and camera validation; the
+//! XPSM, TSM, four warped cascades, the spot fit and its LiSPSM and TSM warps, the
+//! IPSM plan with the paper's and the exact cone, RTW warp tables from a 1-D
+//! importance, and camera validation; the
 //! cascade fits and the four single-frustum warps also from a camera validated once
 //! per frame (`ValidCamera`), and the focus body alone with each warp fitted from a
 //! body built once (`FocusBody`: what a frame pays per technique once the body and
@@ -28,8 +29,8 @@ use shadowmap::frustum::{
 use shadowmap::paraboloid::{ConeFit, IpsmOptions, IpsmPlan};
 use shadowmap::rtw::{ImportanceMap, WarpMaps, WarpOptions};
 use shadowmap::warp::{
-    FocusBody, LispsmOptions, TsmOptions, UniformOptions, XpsmOptions, lispsm, tsm,
-    uniform_focused, warped_cascades, xpsm,
+    FocusBody, LispsmOptions, SpotWarpKind, SpotWarpOptions, TsmOptions, UniformOptions,
+    XpsmOptions, lispsm, spot_warp, tsm, uniform_focused, warped_cascades, xpsm,
 };
 use std::hint::black_box;
 use std::time::Duration;
@@ -142,7 +143,7 @@ struct Outputs {
 }
 
 /// The builders, by name.
-const NAMES: [&str; 27] = [
+const NAMES: [&str; 29] = [
     "bevy_cascades_4",
     "uniform_focused",
     "stable_cascades_4",
@@ -170,6 +171,8 @@ const NAMES: [&str; 27] = [
     "lispsm_valid",
     "ipsm_plan_exact_cone_valid",
     "focus_body_valid_all_4_low_sun",
+    "spot_warp_lispsm",
+    "spot_warp_tsm",
 ];
 
 /// Keeps a builder's result where it was returned (the output is not moved out of
@@ -316,6 +319,23 @@ fn run(f: &Frame, out: &mut Outputs, which: usize) {
                 black_box(&f.point),
                 black_box(&f.valid),
                 Some(f.bounds),
+                &o,
+            ));
+        }
+        27 | 28 => {
+            // The spot fit warped in its post-projective space: the fit, the
+            // candidate strengths and their predicted errors.
+            let kind = if which == 27 {
+                SpotWarpKind::Lispsm
+            } else {
+                SpotWarpKind::Tsm
+            };
+            let o = SpotWarpOptions::default().with_kind(kind);
+            keep(&spot_warp(
+                black_box(&f.spot),
+                cam,
+                Some(f.bounds),
+                &f.scene,
                 &o,
             ));
         }

@@ -29,17 +29,21 @@ pub struct SpotShadow {
 /// every side (the visible part then lies inside the cone, which is all a spot can
 /// light).
 ///
-/// A window narrower than `f32` resolves (a receiver seen edge-on, a sliver far
-/// from the origin) is widened about its middle, within the cone, to 1/500 of the
-/// scene's largest coordinate at its nearest receiver: there a texel of a `1024²`
-/// map spans at least 16 `f32` steps, and both ends of a light ray land on one
-/// texel to a tenth of it.
+/// A window finer than `f32` resolves (a receiver seen edge-on, a sliver far from
+/// the origin) is widened about its middle, within the cone, until the rounding of
+/// its `f32` matrices separates the two ends of a light ray at the nearest
+/// receiver by at most a tenth of a texel of a `1024²` map; a cone too narrow for
+/// that keeps its whole width if it holds them within a texel, and is refused
+/// otherwise.
 ///
 /// # Errors
 /// [`FrustumError::UnsupportedLight`] for a non-spot light; errors of
 /// [`Light::validate`]; [`FrustumError::EmptyBounds`] / [`FrustumError::NonFinite`] for
 /// bad bounds; [`FrustumError::SliceOutsideScene`] when nothing of the region lies in
-/// front of the light within its range.
+/// front of the light within its range; [`FrustumError::DegenerateFrustum`] when
+/// even the whole cone is too narrow at the nearest receiver for `f32` (the two
+/// ends of a light ray more than a texel of a `1024²` map apart) or the matrix is
+/// singular.
 pub fn fit_spot(
     light: &Light,
     frustum: &Frustum,
@@ -83,10 +87,10 @@ pub fn fit_spot(
     let (nearest, [l, r, b, t]) = if window.straddles {
         (near_min, [-cone_tan, cone_tan, -cone_tan, cone_tan])
     } else {
-        (
-            window.nearest,
-            window.resolvable(f64::from(reach), cone_tan),
-        )
+        let rounding = |tangents: [f64; 4]| {
+            ray_rounding(tangents, &light_from_world, position, window.nearest)
+        };
+        (window.nearest, window.resolvable(cone_tan, rounding)?)
     };
     if !(r > l && t > b) {
         return Err(FrustumError::SliceOutsideScene);
@@ -130,14 +134,50 @@ pub fn fit_spot(
     })
 }
 
-/// The smallest width of a fitted window at its nearest receiver, as a fraction of
-/// the scene's largest coordinate: a texel of a `1024²` map there spans at least 16
-/// `f32` steps of the coordinates, so the rounding of the `f32` matrix and points
-/// moves a lookup by under a tenth of a texel. (A perspective map divides that
-/// rounding by the distance from the light: the window of a receiver seen edge-on
-/// 3 mm from a light 0.05 from the origin, 300 `f32` steps wide, put the two ends
-/// of one light ray 0.4 texels apart.)
-const MIN_WINDOW: f64 = 2e-3;
+/// The most the rounding of a spot map's `f32` matrices may separate the two ends
+/// of a light ray at its nearest receiver, in texture coordinates: a tenth of a
+/// texel of a `1024²` map. (A perspective map divides what its rounded `x`, `y`
+/// and `w` rows leave at the light's position, where they vanish in exact
+/// arithmetic, by the distance from the light: the window of a receiver seen
+/// edge-on 3 mm from a light 0.05 from the origin, 44 `f32` steps tall there, put
+/// the two ends of one ray 0.4 texels apart.)
+pub(crate) const RAY_ROUNDING: f64 = 0.1 / 1024.0;
+
+/// How far the rounding of the `f32` matrices of the window `tangents` (left,
+/// right, bottom, top) separates the two ends of a light ray at the distance
+/// `nearest` along the axis, in texture coordinates: what the stored rows leave
+/// at the light's position, `e`, over `w ≥ nearest` (`|u|, |v| ≤ 1`), by the
+/// depth pass's matrix and the lookup's (its rows summed in `f32`), less four
+/// `f32` steps of the light's coordinates over the distance from the light (what
+/// a point's own `f32` coordinates carry; up to `spread w`). Near and far do not
+/// enter those rows.
+fn ray_rounding(
+    tangents: [f64; 4],
+    light_from_world: &glam::DMat4,
+    light: glam::Vec3,
+    nearest: f64,
+) -> f64 {
+    let [l, r, b, t] = tangents;
+    let clip =
+        crate::projection::perspective_off_center(l, r, b, t, 1.0, 2.0, false) * *light_from_world;
+    let map = ShadowTransform::new(
+        glam::Mat4::IDENTITY,
+        clip.as_mat4(),
+        false,
+        LightDirection::Position(light),
+    );
+    let at_light = light.as_dvec3().extend(1.0);
+    let e_clip = (map.clip_from_world.as_dmat4() * at_light).abs();
+    let e_uv = (map.uv_from_world.as_dmat4() * at_light).abs();
+    let by_clip = 0.5 * (e_clip.x.max(e_clip.y) + e_clip.w);
+    let by_uv = e_uv.x.max(e_uv.y) + e_uv.w;
+    // A point's own f32 coordinates already carry a few steps of the light's over
+    // `w`: that much is allowed besides the budget.
+    let (tan_x, tan_y) = (l.abs().max(r.abs()), b.abs().max(t.abs()));
+    let spread = math::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y);
+    let slack = 4.0 * f64::from(f32::EPSILON) * f64::from(light.abs().max_element()) / spread;
+    (by_clip.max(by_uv) - slack).max(0.0) / nearest
+}
 
 /// The tangents of the directions to a region's points, seen from the light.
 struct Window {
@@ -194,15 +234,53 @@ impl Window {
         }
     }
 
-    /// The tangents clamped to the cone `[-cone_tan, cone_tan]²`, each side widened
-    /// about its middle (within the cone) to at least [`MIN_WINDOW`] `reach` at the
-    /// nearest point, `reach` the scene's largest coordinate.
-    fn resolvable(&self, reach: f64, cone_tan: f64) -> [f64; 4] {
-        let least = MIN_WINDOW * reach / self.nearest;
+    /// The tangents clamped to the cone `[-cone_tan, cone_tan]²`, where their
+    /// `rounding` (a window's [`ray_rounding`]) exceeds [`RAY_ROUNDING`] widened
+    /// about their middles (within the cone), both sides by the least factor that
+    /// keeps it within (bisection on its logarithm); the whole cone where even it
+    /// does not, if it keeps the rounding within a texel.
+    ///
+    /// # Errors
+    /// [`FrustumError::DegenerateFrustum`] where even the whole cone leaves more
+    /// than a texel.
+    fn resolvable(
+        &self,
+        cone_tan: f64,
+        rounding: impl Fn([f64; 4]) -> f64,
+    ) -> Result<[f64; 4], FrustumError> {
         let [l, r, b, t] = self.tangents;
-        let (l, r) = widen(l.max(-cone_tan), r.min(cone_tan), least, cone_tan);
-        let (b, t) = widen(b.max(-cone_tan), t.min(cone_tan), least, cone_tan);
-        [l, r, b, t]
+        let (l, r, b, t) = (
+            l.max(-cone_tan),
+            r.min(cone_tan),
+            b.max(-cone_tan),
+            t.min(cone_tan),
+        );
+        if !(r > l && t > b) || rounding([l, r, b, t]) <= RAY_ROUNDING {
+            return Ok([l, r, b, t]);
+        }
+        let scaled = |factor: f64| {
+            let (l, r) = widen(l, r, (r - l) * factor, cone_tan);
+            let (b, t) = widen(b, t, (t - b) * factor, cone_tan);
+            [l, r, b, t]
+        };
+        let full = (2.0 * cone_tan / (r - l)).max(2.0 * cone_tan / (t - b));
+        if !(rounding(scaled(full)) <= RAY_ROUNDING) {
+            return if rounding(scaled(full)) <= 10.0 * RAY_ROUNDING {
+                Ok(scaled(full))
+            } else {
+                Err(FrustumError::DegenerateFrustum)
+            };
+        }
+        let (mut narrow, mut wide) = (0.0, math::ln(full));
+        for _ in 0..30 {
+            let middle = 0.5 * (narrow + wide);
+            if rounding(scaled(math::exp(middle))) <= RAY_ROUNDING {
+                wide = middle;
+            } else {
+                narrow = middle;
+            }
+        }
+        Ok(scaled(math::exp(wide)))
     }
 }
 

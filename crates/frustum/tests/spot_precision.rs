@@ -3,7 +3,9 @@
 //! resolves is kept as fitted.
 
 use glam::{DVec3, Mat4, Vec3, Vec4};
-use shadowmap_frustum::{Aabb, Camera, ConvexBody, Light, Projection, SceneBounds, fit_spot};
+use shadowmap_frustum::{
+    Aabb, Camera, ConvexBody, FrustumError, Light, Projection, SceneBounds, fit_spot,
+};
 use shadowmap_testgen::frustum::ray_gap;
 
 /// The body's vertices and the midpoints of every pair of them.
@@ -17,9 +19,9 @@ fn region_points(body: &ConvexBody) -> Vec<DVec3> {
 }
 
 /// A spot 0.05 from the origin lighting, from its own position along the view, a
-/// receiver slab 1.7e-7 thick and 3 mm away: the receivers' window is 1.5e-5 wide
-/// at them, 300 f32 steps of the coordinates, and put the two ends of a ray 0.37
-/// texels of a 1024² map apart.
+/// receiver slab 1.7e-7 thick and 3 mm away: the receivers' window (5.7e-5 tall,
+/// 1.7e-7 at them, 44 f32 steps of the coordinates) put the two ends of a ray
+/// 0.37 texels of a 1024² map apart.
 #[test]
 fn a_window_finer_than_f32_resolves_is_widened() {
     let position = Vec3::new(-0.045266125, 0.026110286, -0.023142785);
@@ -49,16 +51,9 @@ fn a_window_finer_than_f32_resolves_is_widened() {
 
     let body = ConvexBody::from_frustum_aabb(&frustum, &receivers).unwrap();
     let points = region_points(&body);
-    let reach = points
-        .iter()
-        .fold(f64::from(position.abs().max_element()), |m, p| {
-            m.max(p.abs().max_element())
-        });
-    let [l, r, b, t] = spot.tangents.map(f64::from);
-    let nearest = f64::from(spot.receiver_depth.0);
-    for width in [r - l, t - b] {
-        assert!(width * nearest >= 2e-3 * reach * (1.0 - 1e-5), "{width}");
-    }
+    // The slab's own window is 5.7e-5 tall: widened.
+    let [_, _, b, t] = spot.tangents;
+    assert!(t - b > 1e-3, "{b} {t}");
     let mut checked = 0;
     for p in points {
         if let Some(gap) = ray_gap(&spot.transform, position.as_dvec3(), p) {
@@ -126,4 +121,89 @@ fn a_window_f32_resolves_is_kept() {
         expected.iter().any(|t| t.abs() < cone),
         "the window is the cone's"
     );
+}
+
+/// Found by fuzzing the spot warps: a spot 140 from the origin seeing a thin
+/// receiver slab 84° off its axis. The window's side `(2 x - (l + r) z) / (r - l)`
+/// grows with its tangents (9.4 here) over its width, so a window 0.2 wide at the
+/// nearest receiver (1/500 of the scene's reach) put a ray's ends 1.35e-4 apart.
+#[test]
+fn an_off_axis_window_is_widened_by_its_tangents() {
+    let position = Vec3::new(-99.995674, 74.21842, -99.995674);
+    let light = Light::Spot {
+        position,
+        direction: Vec3::new(0.105249815, 3.9262826e-8, -0.9944458),
+        half_angle: 1.5,
+        range: 399.91803,
+    };
+    let camera = Camera {
+        world_from_view: Mat4::from_cols(
+            Vec4::new(0.0, -1.0, 0.0, 0.0),
+            Vec4::new(1.0, 0.0, 0.0, 0.0),
+            Vec4::Z,
+            Vec4::W,
+        ),
+        projection: Projection::InfinitePerspective {
+            fov_y: 0.023713738,
+            aspect: 0.5055542,
+            near: 0.0010000006,
+            shadow_distance: 99.995674,
+        },
+        reversed_z: false,
+    };
+    let receivers = Aabb::new(
+        Vec3::new(-1.1856911, 0.5994311, -99.995674),
+        Vec3::new(1.1856911, 0.61141974, -0.0010000006),
+    );
+    let frustum = camera.frustum().unwrap();
+    let spot = fit_spot(
+        &light,
+        &frustum,
+        Some(&SceneBounds::new(receivers, receivers)),
+        false,
+    )
+    .unwrap();
+    let body = ConvexBody::from_frustum_aabb(&frustum, &receivers).unwrap();
+    let mut checked = 0;
+    for p in region_points(&body) {
+        if let Some(gap) = ray_gap(&spot.transform, position.as_dvec3(), p) {
+            assert!(gap <= 1e-4, "{p}: the ray's ends {gap} apart");
+            checked += 1;
+        }
+    }
+    assert!(checked > 0);
+}
+
+/// A spot of half angle 0.01, 5,000 from the origin, 0.1 from its nearest visible
+/// receiver: even the whole cone is 0.002 wide there, a texel of a `1024²` map a
+/// tenth of an `f32` step of the scene's coordinates (a ray's ends far more than a
+/// texel apart): refused. The same spot 1,000
+/// from its receivers resolves them.
+#[test]
+fn a_cone_too_narrow_for_f32_at_its_nearest_receiver_is_refused() {
+    let position = Vec3::new(5000.0, 0.0, 0.0);
+    let fit_at = |distance: f32| {
+        let light = Light::Spot {
+            position,
+            direction: Vec3::NEG_Z,
+            half_angle: 0.01,
+            range: 2.0 * distance + 10.0,
+        };
+        let camera = Camera::look_to(
+            position,
+            Vec3::NEG_Z,
+            Vec3::Y,
+            Projection::perspective(0.5, 1.0, 0.05, 2.0 * distance + 10.0),
+        )
+        .unwrap();
+        let receivers = Aabb::new(
+            position + Vec3::new(-1.0, -1.0, -2.0 * distance),
+            position + Vec3::new(1.0, 1.0, -distance),
+        );
+        let scene = SceneBounds::new(receivers, receivers);
+        fit_spot(&light, &camera.frustum().unwrap(), Some(&scene), false)
+    };
+    assert_eq!(fit_at(0.1), Err(FrustumError::DegenerateFrustum));
+    let far = fit_at(1000.0).unwrap();
+    assert!(far.receiver_depth.0 >= 999.0);
 }

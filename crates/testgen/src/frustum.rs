@@ -9,7 +9,7 @@ use glam::{DVec2, DVec3, Mat4, Vec3};
 use shadowmap_frustum::{
     Aabb, Camera, Cascade, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState,
     ConvexBody, DepthBounds, Frustum, Light, SceneBounds, ShadowMapping, ShadowSample,
-    ShadowTransform, SplitScheme, ValidCamera, directional_light_from_world, fit_spot,
+    ShadowTransform, SplitScheme, SpotShadow, ValidCamera, directional_light_from_world, fit_spot,
 };
 
 /// The crate these generators build values of. `shadowmap-frustum`'s own unit tests
@@ -460,10 +460,10 @@ pub fn spot_case_raw(u: &mut Unstructured<'_>) -> GenResult<SpotCase> {
     })
 }
 
-/// Spot fit: accepted fits have finite invertible matrices and `near < far`; where
-/// the window is narrower than the cone on both axes, each visible receiver point
-/// the map stores (frustum ∩ receivers: its vertices) lands on the same texel, to
-/// `f32` rounding, as the point halfway to the light on its ray.
+/// Spot fit: accepted fits have finite invertible matrices and `near < far`; each
+/// visible receiver point the map stores (frustum ∩ receivers: its vertices) lands
+/// on the same texel as the point halfway to the light on its ray, to
+/// [`spot_ray_tolerance`].
 pub fn check_spot(case: &SpotCase) {
     let Ok(frustum) = case.camera.frustum() else {
         return;
@@ -482,13 +482,6 @@ pub fn check_spot(case: &SpotCase) {
     else {
         return;
     };
-    // A window as wide as the cone may be finer than f32 resolves near the light:
-    // nothing wider is lit.
-    let cone = 2.0 * f64::from(half_angle).tan() * (1.0 - 1e-6);
-    let [l, r, b, t] = spot.tangents.map(f64::from);
-    if r - l >= cone || t - b >= cone {
-        return;
-    }
     let body = case
         .scene
         .map(|s| ConvexBody::from_frustum_aabb(&frustum, &s.receivers));
@@ -497,16 +490,34 @@ pub fn check_spot(case: &SpotCase) {
         Some(Err(_)) => return,
         None => &frustum.corners,
     };
-    for p in points {
-        if let Some(gap) = ray_gap(&spot.transform, position.as_dvec3(), p.as_dvec3()) {
-            let scale = p.abs().max_element().max(position.abs().max_element());
-            let tol = 1e-4 + 1e-6 * f64::from(scale) / (*p - position).length() as f64;
+    let light = position.as_dvec3();
+    for p in points.iter().map(|p| p.as_dvec3()) {
+        if let Some(gap) = ray_gap(&spot.transform, light, p) {
+            let tol = spot_ray_tolerance(&spot, half_angle, light, p);
             assert!(
                 gap <= tol,
                 "{p}: its ray's texels {gap} apart (tolerance {tol})"
             );
         }
     }
+}
+
+/// How far apart the two ends of a light ray through `p` may land in a map of the
+/// spot fit `spot` (of a light at `light` with this half angle), in texture
+/// coordinates: a tenth of a texel of a `1024²` map, or a texel where the fit kept
+/// the whole cone on an axis (a cone too narrow for a tenth, or a region reaching
+/// behind the light), plus a few `f32` steps of the coordinates over the distance
+/// from the light.
+pub fn spot_ray_tolerance(spot: &SpotShadow, half_angle: f32, light: DVec3, p: DVec3) -> f64 {
+    let cone = 2.0 * f64::from(half_angle).tan() * (1.0 - 1e-6);
+    let [l, r, b, t] = spot.tangents.map(f64::from);
+    let texels = if r - l >= cone || t - b >= cone {
+        1.0
+    } else {
+        0.1
+    };
+    let scale = p.abs().max_element().max(light.abs().max_element()) / (p - light).length();
+    texels / 1024.0 + 1e-6 * scale
 }
 
 /// How far apart (largest `uv` difference) `map` stores `p` and the point halfway

@@ -8,7 +8,7 @@ use shadowmap_frustum::{
 };
 use shadowmap_warp::{SpotWarpKind, SpotWarpOptions, spot_warp};
 
-use crate::frustum::assert_invertible;
+use crate::frustum::{assert_invertible, spot_ray_tolerance};
 use crate::{GenResult, camera, in_range, log_uniform, unit_vec3};
 
 /// Input of [`check_spot_warp`].
@@ -81,7 +81,8 @@ pub fn spot_warp_case(u: &mut Unstructured<'_>) -> GenResult<SpotWarpCase> {
 /// receivers (frustum ∩ receivers: its vertices, centroid and vertex midpoints) the
 /// spot fit stores inside its map is stored inside the warped map with a depth in
 /// `[0, 1]`, and the point halfway to the light on its ray lands on the same texel
-/// (up to rounding) nearer the light. Returns how many points were checked.
+/// nearer the light (both to [`spot_ray_tolerance`]). Returns how many points were
+/// checked.
 ///
 /// # Errors
 /// A description of the violated clause.
@@ -99,7 +100,12 @@ pub fn check_spot_warp(case: &SpotWarpCase) -> Result<usize, String> {
     if !(w.strength.is_finite() && w.strength >= 0.0) {
         return Err(format!("strength {}", w.strength));
     }
-    let Light::Spot { position, .. } = case.light else {
+    let Light::Spot {
+        position,
+        half_angle,
+        ..
+    } = case.light
+    else {
         return Err("a spot warp for another light".into());
     };
     let Ok(body) = case
@@ -136,8 +142,7 @@ pub fn check_spot_warp(case: &SpotWarpCase) -> Result<usize, String> {
         let (Some(s), Some(sh)) = (w.transform.map_point(p), w.transform.map_point(half)) else {
             return Err(format!("{p}: stored by the spot fit, not by the warp"));
         };
-        let scale = p.abs().max_element().max(l.abs().max_element()) / (p - l).length().max(1e-30);
-        let tol = 1e-4 + 1e-6 * scale;
+        let tol = spot_ray_tolerance(&w.base, half_angle, l, p);
         if !inside(&s, tol) || (s.uv - sh.uv).abs().max_element() > tol {
             return Err(format!("{p}: {s:?}, halfway {sh:?}"));
         }

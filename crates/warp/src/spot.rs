@@ -40,16 +40,18 @@
 //! light's rays, a room seen from inside).
 //!
 //! A warp magnifies the map near its projection centre, and with it the rounding of
-//! its `f32` matrix, which a point near the light divides by its small `w`: the
-//! strength is limited to what keeps the two ends of every light ray through the
-//! visible receivers within a tenth of a texel of a `1024²` map apart (a light far
-//! from the origin, receivers a hair from it).
+//! its `f32` matrices, which a point near the light divides by its small `w`, and
+//! compresses depth toward the far value, where `z` and `w` nearly cancel: the
+//! strength is limited to what keeps that rounding under a tenth of a texel of a
+//! `1024²` map at the visible receivers, in texture coordinates, between the two
+//! ends of a light ray and in depth (a light far from the origin, receivers a hair
+//! from it, a warp along a window's narrow side).
 
 use arrayvec::ArrayVec;
 use glam::{DMat4, DVec2, DVec4, Mat4, Vec2, Vec3};
 use shadowmap_frustum::{
     Camera, DepthBounds, Light, LightDirection, PredictOptions, SceneBounds, ShadowMapping,
-    ShadowTransform, SpotShadow, fit_spot, math, predict_errors,
+    ShadowTransform, SpotShadow, UV_FROM_CLIP, fit_spot, math, predict_errors,
 };
 
 use crate::{MAX_WARP_RATIO, WarpError};
@@ -172,16 +174,20 @@ pub fn spot_warp(
     let LightDirection::Position(position) = base.transform.light else {
         return Ok(keep);
     };
-    let formula = window.resolved(
-        formula,
-        &Rounding::new(&base, position),
-        base.transform.reversed_z,
-    );
-    // The formula's warp, weaker ones, the spot fit turned to the centre line.
-    let strengths = [1.0, 0.5, 0.25, 0.125, 0.0].map(|k| k * formula);
+    let rounding = Rounding::new(&base, position);
+    let formula = window.resolved(formula, &base, &rounding);
+    // The formula's warp, weaker ones, the spot fit turned to the centre line, each
+    // where f32 resolves it (the formula's does by `resolved`; the others may round
+    // differently), then the spot fit itself.
+    let mut strengths: ArrayVec<f64, 5> = ArrayVec::new();
     let mut candidates: ArrayVec<ShadowTransform, 6> = ArrayVec::new();
-    for sigma in strengths {
-        candidates.push(window.transform(&base, sigma)?);
+    for sigma in [1.0, 0.5, 0.25, 0.125, 0.0].map(|k| k * formula) {
+        let clip = window.clip(&base, sigma)?;
+        let map = stored(&base, &clip)?;
+        if rounding.bound(&clip, &map) <= ROUNDING_BUDGET {
+            strengths.push(sigma);
+            candidates.push(map);
+        }
     }
     candidates.push(base.transform);
     let chosen = choose(camera, scene, light, &candidates);
@@ -378,10 +384,11 @@ impl Window {
     /// receivers: within [`ROUNDING_BUDGET`] by `rounding`'s bound, found by
     /// bisection on its logarithm (to a millionth of it); 0 when even a millionth of
     /// `sigma` does not resolve.
-    fn resolved(&self, sigma: f64, rounding: &Rounding, reversed_z: bool) -> f64 {
+    fn resolved(&self, sigma: f64, base: &SpotShadow, rounding: &Rounding) -> f64 {
         let resolves = |sigma: f64| {
-            self.warp(sigma, reversed_z)
-                .is_ok_and(|warp| rounding.bound(&warp) <= ROUNDING_BUDGET)
+            self.clip(base, sigma).is_ok_and(|clip| {
+                stored(base, &clip).is_ok_and(|map| rounding.bound(&clip, &map) <= ROUNDING_BUDGET)
+            })
         };
         if !(sigma > 0.0) || resolves(sigma) {
             return sigma;
@@ -405,21 +412,11 @@ impl Window {
         math::exp(weak)
     }
 
-    /// The warp of strength `sigma` after the spot fit (see the module docs).
-    fn transform(&self, base: &SpotShadow, sigma: f64) -> Result<ShadowTransform, WarpError> {
+    /// The clip matrix of the warp of strength `sigma` after the spot fit (see the
+    /// module docs), exact, before its rounding to `f32` ([`stored`]).
+    fn clip(&self, base: &SpotShadow, sigma: f64) -> Result<DMat4, WarpError> {
         let warp = self.warp(sigma, base.transform.reversed_z)?;
-        let clip = warp * base.transform.clip_from_world.as_dmat4();
-        let clip_from_world: Mat4 = clip.as_mat4();
-        let det = clip_from_world.as_dmat4().determinant();
-        if !clip_from_world.is_finite() || !det.is_finite() || det == 0.0 {
-            return Err(WarpError::Degenerate);
-        }
-        Ok(ShadowTransform::new(
-            base.transform.light_from_world,
-            clip_from_world,
-            base.transform.reversed_z,
-            base.transform.light,
-        ))
+        Ok(warp * base.transform.clip_from_world.as_dmat4())
     }
 
     /// The warp of strength `sigma`, from the spot fit's clip coordinates to the
@@ -453,45 +450,110 @@ impl Window {
     }
 }
 
-/// The most `f32` rounding may separate the two ends of a light ray at a receiver
-/// of a warped map, in device units: a tenth of a texel of a `1024²` map.
-const ROUNDING_BUDGET: f64 = 0.2 / 1024.0;
-
-/// How far the rounding of the `f32` matrices separates the two ends of one light
-/// ray in the spot fit warped by a matrix `W`, at the visible receivers.
+/// The map that stores the clip matrix `clip` in `f32`, after the spot fit `base`.
 ///
-/// In exact arithmetic the warped map's `x`, `y` and `w` rows all vanish at the
-/// light's position: every light ray is one line through it. The `f32` matrix
-/// `round(W C)` (`C` the spot fit's `f32` matrix, itself rounded) leaves there an
-/// error `e`, computed here exactly, which a point at `w` carries as `e / w`: the
-/// nearer the light, the larger, so the two ends of a ray land on different texels.
-/// Inside the map `q ≥ 1`, so `w` is at least the distance along the spot's axis,
-/// and `|x / w| ≤ 1`: a receiver's device coordinates move by at most
-/// `(|e_x| + |e_w|) / nearest` (likewise `y`).
+/// # Errors
+/// [`WarpError::Degenerate`] where the rounded matrix is not finite or singular.
+fn stored(base: &SpotShadow, clip: &DMat4) -> Result<ShadowTransform, WarpError> {
+    let clip_from_world: Mat4 = clip.as_mat4();
+    let det = clip_from_world.as_dmat4().determinant();
+    if !clip_from_world.is_finite() || !det.is_finite() || det == 0.0 {
+        return Err(WarpError::Degenerate);
+    }
+    Ok(ShadowTransform::new(
+        base.transform.light_from_world,
+        clip_from_world,
+        base.transform.reversed_z,
+        base.transform.light,
+    ))
+}
+
+/// The most `f32` rounding may move a lookup of a warped map at a receiver (its
+/// texture coordinates, or the two ends of a light ray apart, or its depth): a
+/// tenth of a texel of a `1024²` map.
+const ROUNDING_BUDGET: f64 = 0.1 / 1024.0;
+
+/// How far the rounding of a warped spot map's `f32` matrices moves a lookup at the
+/// visible receivers: its texture coordinates, the two ends of a light ray apart,
+/// and its depth.
+///
+/// A stored row `r` (of `clip_from_world`, the depth pass's, or `uv_from_world`,
+/// the lookup's, its rows summed in `f32`) errs at a point `p` by its value at the
+/// light's position plus its rounding times `p - light`; a point at `w` carries
+/// that as a move of `r / w` by about `(|r(light)| + |w(light)|) / w` plus
+/// `(|δr|₁ + |δw|₁) |p - light| / w` (`δ` the rounding, `|r / w| ≤ 1`). In exact
+/// arithmetic the `x`, `y` and `w` rows (so `u w` and `v w`) vanish at the light:
+/// every light ray is one line through it, and what the stored rows leave there,
+/// divided by the small `w` of a point near the light, is what separates the two
+/// ends of a ray. Depth (`z / w`, with `z` nearly `w` where the warp compresses it
+/// toward the far value) reads the rounding alone. Inside the map `q ≥ 1`, so `w`
+/// is at least the distance `d ≥ nearest` along the spot's axis, and
+/// `|p - light| ≤ spread d`.
 struct Rounding {
-    /// The spot fit's matrix `C`.
-    base: DMat4,
     /// The light's position, `(light, 1)`.
     light: DVec4,
     /// The nearest receivers' distance along the spot's axis.
     nearest: f64,
+    /// The largest distance from the light per unit along its axis in the window.
+    spread: f64,
+    /// What a point's own `f32` coordinates already carry at `w`, times `w`
+    /// ([`F32_STEPS`] steps of the light's largest coordinate, over `spread`: the
+    /// point's distance from the light is up to `spread w`): allowed besides the
+    /// budget, so a region reaching the light's plane, whose points come
+    /// arbitrarily near it, keeps its warps.
+    slack: f64,
 }
+
+/// How many `f32` steps of the light's coordinates the matrices may add to a
+/// lookup at `w`, over `w`, besides [`ROUNDING_BUDGET`].
+const F32_STEPS: f64 = 4.0;
 
 impl Rounding {
     fn new(base: &SpotShadow, light: Vec3) -> Self {
+        let [l, r, b, t] = base.tangents.map(f64::from);
+        let tan_x = l.abs().max(r.abs());
+        let tan_y = b.abs().max(t.abs());
+        let spread = math::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y);
         Self {
-            base: base.transform.clip_from_world.as_dmat4(),
             light: light.as_dvec3().extend(1.0),
             nearest: f64::from(base.receiver_depth.0),
+            spread,
+            slack: F32_STEPS * f64::from(f32::EPSILON) * f64::from(light.abs().max_element())
+                / spread,
         }
     }
 
-    /// The bound, in device units, for the warp `warp` (clip from the spot fit's
-    /// clip coordinates), read off the `f32` matrix [`Window::transform`] stores.
-    fn bound(&self, warp: &DMat4) -> f64 {
-        let stored = (*warp * self.base).as_mat4().as_dmat4();
-        let e = (stored * self.light).abs();
-        (e.x.max(e.y) + e.w) / self.nearest
+    /// The bound, in texture coordinates and depth, for `map`, stored from the
+    /// exact clip matrix `clip`.
+    fn bound(&self, clip: &DMat4, map: &ShadowTransform) -> f64 {
+        let stored_clip = map.clip_from_world.as_dmat4();
+        let stored_uv = map.uv_from_world.as_dmat4();
+        let uv = UV_FROM_CLIP.as_dmat4() * *clip;
+        // Device coordinates span 2 across the map, texture coordinates 1.
+        let texel = |row: usize| {
+            self.moved(&stored_uv, &uv, row, false)
+                .max(0.5 * self.moved(&stored_clip, clip, row, false))
+        };
+        let depth = self.moved(&stored_clip, clip, 2, true);
+        texel(0).max(texel(1)).max(depth)
+    }
+
+    /// How far the rounding of `stored` (from `exact`) moves its row `row` over `w`
+    /// at a receiver; at the light, the stored rows' values, or with
+    /// `rounding_only` their rounding's.
+    fn moved(&self, stored: &DMat4, exact: &DMat4, row: usize, rounding_only: bool) -> f64 {
+        let rounding = |r: usize| stored.row(r) - exact.row(r);
+        let at_light = |r: usize| {
+            let value = if rounding_only {
+                rounding(r)
+            } else {
+                stored.row(r)
+            };
+            value.dot(self.light).abs()
+        };
+        let per_unit = |r: usize| rounding(r).truncate().abs().element_sum();
+        let at_light = (at_light(row) + at_light(3) - self.slack).max(0.0);
+        at_light / self.nearest + (per_unit(row) + per_unit(3)) * self.spread
     }
 }
 

