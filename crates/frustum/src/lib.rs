@@ -128,7 +128,7 @@ pub use light::{Light, directional_light_from_world};
 pub use light_prism::LightPrism;
 pub use mapping::{
     LightDirection, ShadowMapping, ShadowSample, ShadowTransform, UV_FROM_CLIP, is_invertible,
-    projective_uv_differentials, uv_differentials_by_points,
+    is_invertible_at, projective_uv_differentials, uv_differentials_by_points,
 };
 pub use predict::{
     FRONT_LIT_MIN_COS, MAX_PREDICT_CANDIDATES, MAX_PREDICT_RAYS, PredictOptions, PredictedError,

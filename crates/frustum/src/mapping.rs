@@ -301,11 +301,29 @@ impl ShadowMapping for ShadowTransform {
 /// row equal to the `w` row for a tiny near plane far from the origin; scaling by the
 /// world's magnitude keeps the test independent of the world's units.
 pub fn is_invertible(m: &Mat4, world_scale: f32) -> bool {
-    use glam::Vec4Swizzles;
+    is_invertible_at(m, &[world_scale])
+}
+
+/// [`is_invertible`] for world coordinates of each magnitude in `world_scales` (a
+/// matrix evaluated over two regions of different reach, e.g. its fitted region and
+/// the receivers it is looked up at): the conversion, the finiteness and the
+/// determinant made once. `true` for no scales when `m` is finite and invertible.
+pub fn is_invertible_at(m: &Mat4, world_scales: &[f32]) -> bool {
     if !m.is_finite() {
         return false;
     }
     let d = m.as_dmat4();
+    if !world_scales.iter().all(|&s| rows_apart(&d, s)) {
+        return false;
+    }
+    let det = d.determinant();
+    det != 0.0 && det.is_finite()
+}
+
+/// No two rows of `d * diag(s, s, s, 1)` (s = `world_scale`) within `1e-6` rad of
+/// parallel, and none zero (see [`is_invertible`]).
+fn rows_apart(d: &DMat4, world_scale: f32) -> bool {
+    use glam::Vec4Swizzles;
     let s = f64::from(world_scale.abs()).max(f64::MIN_POSITIVE);
     let s2 = s * s;
     // The Gram matrix of the scaled rows, `sum_c w_c col_c col_c^T` over the columns
@@ -332,15 +350,10 @@ pub fn is_invertible(m: &Mat4, world_scale: f32) -> bool {
         norms.z * norms.w,
     ];
     // sin² of the angle between two rows below 1e-12, without a division.
-    if dots
+    !dots
         .iter()
         .zip(&products)
         .any(|(dot, nn)| nn - dot * dot < 1e-12 * nn)
-    {
-        return false;
-    }
-    let det = d.determinant();
-    det != 0.0 && det.is_finite()
 }
 
 /// Whether [`is_invertible`] accepts, for every world scale of at least

@@ -254,6 +254,11 @@ pub(crate) struct Focus {
     pub(crate) caster_scale: f64,
     pub(crate) light_caster_scale: f64,
     pub(crate) receiver_scale: f64,
+    /// ... the light-space bounds of `receivers` (their footprint across the
+    /// light) and their view-depth range (nearest and farthest distance along the
+    /// view direction), which the warps' strength formulas read, ...
+    pub(crate) footprint: Bounds,
+    pub(crate) receiver_depth: (f64, f64),
     /// ... how far the receivers' footprint is from thin ([`footprint_weight`]) ...
     pub(crate) wide: f64,
     /// ... and how far the fitted boxes are widened toward turn-invariance near the
@@ -292,10 +297,13 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
     // The receivers' light-space bounds: the caster prism's and the footprint's.
     let mut footprint = Bounds::EMPTY;
     let mut light_caster_scale = f64::MIN_POSITIVE;
+    let mut receiver_depth = (f64::INFINITY, f64::NEG_INFINITY);
     for p in &receivers {
         let q = rot.transform_point3(*p);
         footprint.add(q);
         light_caster_scale = light_caster_scale.max(q.abs().max_element());
+        let d = (*p - view.eye).dot(view.forward);
+        receiver_depth = (receiver_depth.0.min(d), receiver_depth.1.max(d));
     }
     let mut casters = Points::new();
     caster_points(&rot, &receivers, &footprint, &caster_box, &mut casters);
@@ -316,6 +324,8 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
             light_from_world,
             sin_gamma,
             wide: footprint_weight(&footprint, receiver_scale),
+            footprint,
+            receiver_depth,
             turn_weight: crate::lispsm::turn_invariant_weight(axis_length),
             caster_scale: scale_of(&casters),
             light_caster_scale,
@@ -338,8 +348,10 @@ fn focus(view: View, light: Vec3, scene: &SceneBounds) -> Result<FocusBody, Warp
 /// [`FocusBody::tsm`]) without repeating the validation, the clipping or the frame.
 /// The warps choose their strengths on the predicted aliasing error at probe points
 /// of the body (most of a warp's time); the body fills those points when the first
-/// warp needs them and keeps them, so LiSPSM, XPSM and TSM from one body (or one
-/// warp at several strength scales) cast the probe rays once. That cache makes a
+/// warp needs them, with the uniform fit's predicted error on them (every warp's
+/// strength 0, the baseline its strength is judged against), and keeps them, so
+/// LiSPSM, XPSM and TSM from one body (or one warp at several strength scales)
+/// cast the probe rays and fit the baseline once. That cache makes a
 /// body `Send` but not `Sync`: fit from one thread, or clone it per thread. The
 /// points are fixed-capacity arrays (no allocation), so a body is about 28 KB:
 /// build it where it is used, or keep one per light, rather than moving it.
@@ -376,13 +388,18 @@ pub struct FocusBody {
 }
 
 impl FocusBody {
-    /// The probe points the warps choose their strengths on, cast on first use.
+    /// The probe points the warps choose their strengths on, with the uniform fit's
+    /// error on them, made on first use.
     pub(crate) fn probe(&self) -> Ref<'_, Probe> {
         if !self.probe.borrow().is_filled() {
             // Filled where it lives: a probe is too large to build and move. No
             // borrow is held here (a probe is only read while a warp chooses its
             // strength, and filled before), so the mutable borrow cannot fail.
-            self.probe.borrow_mut().fill(&self.view, &self.focus);
+            let uniform = crate::lispsm::warp_clip(&self.focus, &self.view, 0.0, false);
+            let uniform = uniform.ok().map(|fit| fit.clip_from_light);
+            self.probe
+                .borrow_mut()
+                .fill(&self.view, &self.focus, uniform.as_ref());
         }
         self.probe.borrow()
     }
@@ -641,18 +658,20 @@ pub(crate) fn ortho_fit(b: &Bounds, reversed_z: bool) -> DMat4 {
 }
 
 /// Converts a fit of `f` to the `f32` output, refusing non-finite or singular
-/// results: the matrix must be invertible for world coordinates up to
-/// `world_scale` (`shadowmap_frustum::is_invertible`). (The light frame's `f32`
+/// results: the matrix must be invertible for world coordinates up to each of
+/// `world_scales` (`shadowmap_frustum::is_invertible_at`: the fit's reach, and
+/// where they differ the receivers' it is looked up at). (The light frame's `f32`
 /// matrix was checked when the body was built.)
 pub(crate) fn finish(
     f: &Focus,
     clip_from_world: DMat4,
     reversed_z: bool,
-    world_scale: f64,
+    world_scales: &[f32],
 ) -> Result<ShadowTransform, WarpError> {
     let clip = clip_from_world.as_mat4();
-    let scale = world_scale as f32;
-    if !(matrix_ok(&clip) && scale.is_finite() && shadowmap_frustum::is_invertible(&clip, scale)) {
+    let scales_ok = world_scales.iter().all(|s| s.is_finite());
+    if !(matrix_ok(&clip) && scales_ok && shadowmap_frustum::is_invertible_at(&clip, world_scales))
+    {
         return Err(WarpError::Degenerate);
     }
     let t = ShadowTransform::new(

@@ -168,7 +168,7 @@ impl FocusBody {
     /// [`WarpError::InvalidOption`]; [`WarpError::Degenerate`].
     pub fn lispsm(&self, options: &LispsmOptions) -> Result<LispsmShadow, WarpError> {
         options.check()?;
-        let (s, fade) = warp_strength(&self.focus, &self.view, options);
+        let (s, fade) = warp_strength(&self.focus, options);
         let (transform, s) = fit_chosen(self, s, options.strength_scale, options.reversed_z)?;
         Ok(LispsmShadow {
             transform,
@@ -183,10 +183,10 @@ impl FocusBody {
 }
 
 /// The warp strength `s = 1/n` and the fade weight.
-fn warp_strength(f: &Focus, view: &View, o: &LispsmOptions) -> (f64, f64) {
+fn warp_strength(f: &Focus, o: &LispsmOptions) -> (f64, f64) {
     let fade = o.fade.weight(f.sin_gamma);
     let hints = (f64::from(o.near_hint), f64::from(o.far_hint));
-    (strength(f, view, f64::from(o.eta), hints, fade), fade)
+    (strength(f, f64::from(o.eta), hints, fade), fade)
 }
 
 /// LiSPSM's warp strength `s = 1/n` for strength parameter `eta`, view-depth hints
@@ -195,17 +195,12 @@ fn warp_strength(f: &Focus, view: &View, o: &LispsmOptions) -> (f64, f64) {
 /// `ln(1 + s d)`, `d` the body's extent along the warp axis, is interpolated in
 /// `eta` between uniform, `n_opt` and `n_psm`, clamped to `ln MAX_WARP_RATIO` and
 /// scaled by `fade`, so the warp ratio goes continuously to 1 as `fade` goes to 0.
-pub(crate) fn strength(f: &Focus, view: &View, eta: f64, hints: (f64, f64), fade: f64) -> f64 {
+pub(crate) fn strength(f: &Focus, eta: f64, hints: (f64, f64), fade: f64) -> f64 {
     if fade <= 0.0 || eta <= -1.0 {
         return 0.0;
     }
     // View-depth range of the visible receivers, narrowed by the hints.
-    let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
-    for p in &f.receivers {
-        let d = (*p - view.eye).dot(view.forward);
-        z_n = z_n.min(d);
-        z_f = z_f.max(d);
-    }
+    let (mut z_n, mut z_f) = f.receiver_depth;
     let z_scale = z_f.abs().max(z_n.abs()).max(f64::MIN_POSITIVE);
     z_n = z_n.max(hints.0).max(1e-6 * z_scale);
     z_f = z_f.min(hints.1).max(z_n);
@@ -252,7 +247,13 @@ pub(crate) fn warp_fit(
     reversed_z: bool,
 ) -> Result<(ShadowTransform, f64), WarpError> {
     let fit = warp_clip(f, view, s, reversed_z)?;
-    finish(f, fit.clip_from_world, reversed_z, fit.world_scale).map(|t| (t, fit.s))
+    finish(
+        f,
+        fit.clip_from_world,
+        reversed_z,
+        &[fit.world_scale as f32],
+    )
+    .map(|t| (t, fit.s))
 }
 
 /// A fit of [`warp_clip`]: its `f64` clip matrices, the `s` used and the world
@@ -408,9 +409,13 @@ pub(crate) fn fit_chosen(
     let mut fits = Fits::new();
     let chosen = chosen_strength(body, s_formula, scale, reversed_z, &mut fits);
     match chosen.kept.and_then(|t| fits.at(t)) {
-        Some(fit) => {
-            finish(f, fit.clip_from_world, reversed_z, fit.world_scale).map(|t| (t, fit.s))
-        }
+        Some(fit) => finish(
+            f,
+            fit.clip_from_world,
+            reversed_z,
+            &[fit.world_scale as f32],
+        )
+        .map(|t| (t, fit.s)),
         None => warp_fit(f, view, chosen.s, reversed_z),
     }
 }

@@ -58,7 +58,8 @@ const _: () = assert!(DEPTHS == 4);
 /// Exponent of the power mean over the probe points (between a mean and a maximum,
 /// close to the high percentiles by which the quality report ranks techniques).
 const POWER: i32 = 8;
-// `points_error` raises `1 / s²` to the fourth power.
+// `points_error` raises `1 / s²` to the fourth power and takes the mean's eighth
+// root as three square roots.
 const _: () = assert!(POWER == 8);
 
 /// One probe point: the world point, the world displacements of one screen step in
@@ -168,6 +169,10 @@ pub(crate) struct Probe {
     perspective: ProbePoints,
     /// The weight the points would carry if every surface were front-lit.
     geometric: f64,
+    /// The uniform fit's error ([`points_error`]) over `points` and over
+    /// `perspective` (infinite where that fit fails or the set was not cast): every
+    /// warp's strength 0, so computed once with the points (see [`Probe::fill`]).
+    uniform_error: [f64; 2],
     /// Whether [`Probe::fill`] has cast the points.
     filled: bool,
 }
@@ -180,6 +185,7 @@ impl Probe {
             points: ProbePoints::new(),
             perspective: ProbePoints::new(),
             geometric: 0.0,
+            uniform_error: [f64::INFINITY; 2],
             filled: false,
         }
     }
@@ -190,14 +196,33 @@ impl Probe {
     }
 
     /// Casts the probe points of `f` seen from `view` (the face-normal set, and
-    /// the perspective set where the confidence is below 1), replacing any.
-    pub(crate) fn fill(&mut self, view: &View, f: &Focus) {
+    /// the perspective set where the confidence is below 1), replacing any, and
+    /// predicts the error of the uniform fit, whose clip matrix from the light frame
+    /// is `uniform_clip_from_light` (`None` where it fails), over each.
+    ///
+    /// Every warp at strength 0 is that fit: LiSPSM's and TSM's exactly (the same
+    /// [`warp_clip`](crate::lispsm::warp_clip)), XPSM's orthographic fit of the
+    /// same footprint, cut by the caster box where that box is narrower (then
+    /// finer, never coarser). So the baseline each warp's strength is judged
+    /// against ([`choose`]'s ratio) is the uniform fit's, made once per body rather
+    /// than once per warp.
+    pub(crate) fn fill(&mut self, view: &View, f: &Focus, uniform_clip_from_light: Option<&DMat4>) {
         let rays = Rays::new(view, f);
         self.points.clear();
         self.perspective.clear();
         self.geometric = rays.cast(Pass::Lit, &mut self.points);
-        if self.confidence() < 1.0 {
+        let cast_perspective = self.confidence() < 1.0;
+        if cast_perspective {
             rays.cast(Pass::Perspective, &mut self.perspective);
+        }
+        self.uniform_error = [f64::INFINITY; 2];
+        if let Some(clip) = uniform_clip_from_light {
+            if self.confidence() > 0.0 {
+                self.uniform_error[0] = points_error(&self.points, clip);
+            }
+            if cast_perspective {
+                self.uniform_error[1] = points_error(&self.perspective, clip);
+            }
         }
         self.filled = true;
     }
@@ -222,35 +247,56 @@ impl Probe {
         fit_at: impl FnMut(f64) -> Option<T>,
         clip_from_light: impl Fn(&T) -> &DMat4,
     ) -> f64 {
-        self.strength_with(fits, fit_at, clip_from_light, &self.perspective)
+        self.strength_with(
+            fits,
+            fit_at,
+            clip_from_light,
+            (&self.perspective, self.uniform_error),
+        )
     }
 
     /// [`Probe::strength`] with the perspective set `perspective` (read only where
-    /// the confidence is below 1).
+    /// the confidence is below 1) and the errors at strength 0 over the two sets,
+    /// `uniform_error` (the warp's fits start at the next strength of the grid).
     fn strength_with<T>(
         &self,
         fits: &mut Fits<T>,
         mut fit_at: impl FnMut(f64) -> Option<T>,
         clip_from_light: impl Fn(&T) -> &DMat4,
-        perspective: &ProbePoints,
+        (perspective, uniform_error): (&ProbePoints, [f64; 2]),
     ) -> f64 {
         let confidence = self.confidence();
-        let mut error_at = |t: f64, points: &ProbePoints| {
+        let mut error_at = |t: f64, points: &ProbePoints, uniform: f64| {
+            if t == 0.0 {
+                return uniform;
+            }
             fits.get_or_make(grid_index(t), || fit_at(t))
                 .map_or(f64::INFINITY, |fit| {
                     points_error(points, clip_from_light(fit))
                 })
         };
-        let lit = (confidence > 0.0).then(|| choose(|t| error_at(t, &self.points)));
+        let lit =
+            (confidence > 0.0).then(|| choose(|t| error_at(t, &self.points, uniform_error[0])));
         match lit {
             Some(t) if confidence >= 1.0 => t,
             _ => {
-                let perspective = choose(|t| error_at(t, perspective));
+                let perspective = choose(|t| error_at(t, perspective, uniform_error[1]));
                 lit.map_or(perspective, |t| {
                     perspective + (t - perspective) * confidence
                 })
             }
         }
+    }
+
+    /// The predicted error of the fit whose clip matrix from the light frame is
+    /// `clip_from_light` over the face-normal set, and the uniform fit's there (as
+    /// [`Probe::fill`] predicted it).
+    #[cfg(test)]
+    pub(crate) fn lit_errors(&self, clip_from_light: &DMat4) -> (f64, f64) {
+        (
+            points_error(&self.points, clip_from_light),
+            self.uniform_error[0],
+        )
     }
 
     /// How far the prediction is to be trusted, in `[0, 1]`: 0 when no probe point
@@ -350,7 +396,9 @@ fn points_error(points: &ProbePoints, clip_from_light: &DMat4) -> f64 {
     let sum = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
     let weights = points.weight_sum;
     if weights > 0.0 {
-        math::powf(sum / weights, 1.0 / f64::from(POWER))
+        // The eighth root as three square roots (to an ulp or two of `powf`'s, in
+        // a third of its time).
+        math::sqrt(math::sqrt(math::sqrt(sum / weights)))
     } else {
         0.0
     }

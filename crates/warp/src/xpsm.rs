@@ -295,12 +295,11 @@ fn xpsm_body(body: &FocusBody, options: &XpsmOptions) -> Result<XpsmShadow, Warp
             &fresh
         }
     };
-    let transform = finish(f, fit.clip(&space), options.reversed_z, fit.world_scale)?;
-    // The lookup is evaluated at the receivers: the matrix must resolve them too (a
-    // depth range spanning absurdly tall casters can leave it singular there).
-    if !shadowmap_frustum::is_invertible(&transform.clip_from_world, f.receiver_scale as f32) {
-        return Err(WarpError::Degenerate);
-    }
+    // The lookup is evaluated at the receivers: the matrix must resolve them too,
+    // not only the whole caster box's reach (a depth range spanning absurdly tall
+    // casters can leave it singular there).
+    let scales = [fit.world_scale as f32, f.receiver_scale as f32];
+    let transform = finish(f, fit.clip(&space), options.reversed_z, &scales)?;
     // Step 18: Z bias scale, 1 / (MaxZ - MinZ).
     let z_bias_scale = (1.0 / fit.z_extent) as f32;
     if !(z_bias_scale.is_finite() && z_bias_scale > 0.0) {
@@ -399,32 +398,33 @@ impl XpsmSpace {
     /// The space of `f` seen from `view`, with the origin moved by `shift`.
     fn new(view: &View, f: &Focus, options: &XpsmOptions, shift: f64) -> Self {
         let eps_w = f64::from(options.epsilon_w);
-        let light_space = DMat4::from_translation(DVec3::new(0.0, -shift, 0.0))
-            * f.rot
-            * DMat4::from_translation(-view.eye);
-        let receivers: ReceiverPoints = f
-            .receivers
-            .iter()
-            .map(|p| light_space.transform_point3(*p))
-            .collect();
-        let casters: ArrayVec<DVec3, 8> = f
-            .caster_box
-            .corners()
-            .iter()
-            .map(|p| light_space.transform_point3(p.as_dvec3()))
-            .collect();
+        let light_space = light_space(&f.rot, view.eye, shift);
+        // One pass over each set: the points in light space, their smallest and
+        // largest projections on unit P (step 4) and their largest coordinate.
         let proj = |p: &DVec3| p.x * UNIT_P.x + p.y * UNIT_P.y;
-        // Step 4: minimal projections on unit P.
-        let min_casters = casters.iter().map(proj).fold(f64::INFINITY, f64::min);
-        let min_receivers = receivers.iter().map(proj).fold(f64::INFINITY, f64::min);
-        let max_proj = casters
-            .iter()
-            .chain(&receivers)
-            .map(proj)
-            .fold(f64::NEG_INFINITY, f64::max);
+        let mut max_proj = f64::NEG_INFINITY;
+        let mut receivers = ReceiverPoints::new();
+        let (mut min_receivers, mut receiver_scale) = (f64::INFINITY, f64::MIN_POSITIVE);
+        for p in &f.receivers {
+            let q = light_space.transform_point3(*p);
+            min_receivers = min_receivers.min(proj(&q));
+            max_proj = max_proj.max(proj(&q));
+            receiver_scale = receiver_scale.max(q.abs().max_element());
+            // The same capacity as the body's receivers.
+            let _ = receivers.try_push(q);
+        }
+        let mut casters = ArrayVec::<DVec3, 8>::new();
+        let (mut min_casters, mut caster_scale) = (f64::INFINITY, f64::MIN_POSITIVE);
+        for p in f.caster_box.corners() {
+            let q = light_space.transform_point3(p.as_dvec3());
+            min_casters = min_casters.min(proj(&q));
+            max_proj = max_proj.max(proj(&q));
+            caster_scale = caster_scale.max(q.abs().max_element());
+            let _ = casters.try_push(q);
+        }
         // Step 5: maximal length of the projection vector (eq. 3).
         let min_focus = min_casters.max(min_receivers);
-        let scale = scale_of(&receivers).max(scale_of(&casters));
+        let scale = receiver_scale.max(caster_scale);
         let max_length_p = if min_focus < -1e-12 * scale {
             (eps_w - 1.0) / min_focus
         } else {
@@ -449,6 +449,20 @@ impl XpsmSpace {
             world_scale,
         }
     }
+}
+
+/// Step 1: light space, `T(0, -shift, 0) · rot · T(-eye)` (`rot` the light frame,
+/// `eye` the viewer), built as that product computes it, without its products of
+/// zeros: the rotation's columns, and the translation `rot · (-eye)` moved by
+/// `-shift` along `y` (the same values).
+fn light_space(rot: &DMat4, eye: DVec3, shift: f64) -> DMat4 {
+    let t = rot.mul_vec4((-eye).extend(1.0));
+    DMat4::from_cols(
+        rot.x_axis,
+        rot.y_axis,
+        rot.z_axis,
+        DVec4::new(t.x, t.y - shift, t.z, t.w),
+    )
 }
 
 /// Unit P in light space: the shared light frame has `+Y` along `V_xy`.
@@ -533,32 +547,10 @@ fn xpsm_fit(
     };
     let (min, max) = (region.min, region.max);
     let ext = max - min;
-    // Step 15: unit cube = inverse of the focus region basis.
-    let unit_cube = DMat4::from_cols(
-        DVec4::new(1.0 / ext.x, 0.0, 0.0, 0.0),
-        DVec4::new(0.0, 1.0 / ext.y, 0.0, 0.0),
-        DVec4::new(0.0, 0.0, 1.0 / ext.z, 0.0),
-        DVec4::new(-min.x / ext.x, -min.y / ext.y, -min.z / ext.z, 1.0),
-    );
-    // Step 16: normalized space, WebGPU: x, y to [-1, 1]; the unit-cube z grows toward
-    // the light, so standard depth is 1 - z and reversed-Z depth is z.
-    let normalized = if options.reversed_z {
-        DMat4::from_cols(
-            DVec4::new(2.0, 0.0, 0.0, 0.0),
-            DVec4::new(0.0, 2.0, 0.0, 0.0),
-            DVec4::new(0.0, 0.0, 1.0, 0.0),
-            DVec4::new(-1.0, -1.0, 0.0, 1.0),
-        )
-    } else {
-        DMat4::from_cols(
-            DVec4::new(2.0, 0.0, 0.0, 0.0),
-            DVec4::new(0.0, 2.0, 0.0, 0.0),
-            DVec4::new(0.0, 0.0, -1.0, 0.0),
-            DVec4::new(-1.0, -1.0, 1.0, 1.0),
-        )
-    };
-    // Step 17 (its product with light space made for the fit kept: `XpsmFit::clip`).
-    let clip_from_light_space = normalized * unit_cube * ppls_from_light_space;
+    // Steps 15-17 (its product with light space made for the fit kept:
+    // `XpsmFit::clip`).
+    let clip_from_light_space =
+        clip_from_region(min, ext, options.reversed_z) * ppls_from_light_space;
     // Light space is the light frame (`Focus::rot`) moved by its translation: the
     // product with that translation keeps the first three columns.
     let m = &clip_from_light_space;
@@ -576,6 +568,52 @@ fn xpsm_fit(
         length_p,
         max_length_p,
     })
+}
+
+/// Steps 15 and 16, the map from a focus region (its corner `min` and extent `ext`)
+/// to clip space: the unit cube (the inverse of the region's basis), then WebGPU's
+/// normalized space, `x` and `y` to `[-1, 1]`; the unit cube's `z` grows toward
+/// the light, so standard depth is `1 - z` and reversed-Z depth is `z`.
+///
+/// Both are scales with offsets, so their product is one: each column of a matrix
+/// it multiplies maps as `scale * c + offset * c.w`, the values the product of the
+/// full matrices computes (its other terms are products with zeros).
+#[derive(Clone, Copy)]
+struct AxisMap {
+    scale: DVec4,
+    offset: DVec4,
+}
+
+impl core::ops::Mul<DMat4> for AxisMap {
+    type Output = DMat4;
+
+    fn mul(self, m: DMat4) -> DMat4 {
+        let column = |c: DVec4| self.scale * c + self.offset * c.w;
+        DMat4::from_cols(
+            column(m.x_axis),
+            column(m.y_axis),
+            column(m.z_axis),
+            column(m.w_axis),
+        )
+    }
+}
+
+/// [`AxisMap`] of the region at `min` of extent `ext`.
+fn clip_from_region(min: DVec3, ext: DVec3, reversed_z: bool) -> AxisMap {
+    // The unit cube: `(p - min) / ext`, as `p / ext - min / ext`.
+    let inv = DVec3::new(1.0 / ext.x, 1.0 / ext.y, 1.0 / ext.z);
+    let start = DVec3::new(-min.x / ext.x, -min.y / ext.y, -min.z / ext.z);
+    // Then `2 u - 1` across the light and `1 - u` (standard) or `u` (reversed)
+    // along it.
+    let (z_scale, z_offset) = if reversed_z {
+        (inv.z, start.z)
+    } else {
+        (-inv.z, -start.z + 1.0)
+    };
+    AxisMap {
+        scale: DVec4::new(2.0 * inv.x, 2.0 * inv.y, z_scale, 0.0),
+        offset: DVec4::new(2.0 * start.x - 1.0, 2.0 * start.y - 1.0, z_offset, 1.0),
+    }
 }
 
 /// `lengthP` for the full length `full` over an extent `d` along `unit P`, faded
@@ -615,16 +653,8 @@ fn auto_length(f: &Focus, view: &View, weight: f64) -> (f64, f64) {
     if !(weight > 0.0) {
         return (0.0, 0.0);
     }
-    let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
-    let (mut r0, mut r1) = (f64::INFINITY, f64::NEG_INFINITY);
-    for p in &f.receivers {
-        let d = (*p - view.eye).dot(view.forward);
-        z_n = z_n.min(d);
-        z_f = z_f.max(d);
-        let y = f.rot.transform_point3(*p).y;
-        r0 = r0.min(y);
-        r1 = r1.max(y);
-    }
+    let (z_n, z_f) = f.receiver_depth;
+    let (r0, r1) = (f.footprint.min.y, f.footprint.max.y);
     let z_scale = z_f.abs().max(z_n.abs()).max(f64::MIN_POSITIVE);
     let z_n = z_n.max(1e-6 * z_scale);
     let z_f = z_f.max(z_n);
@@ -653,21 +683,18 @@ impl Ppls {
     /// D3D's left-handed frame; here the rotation (Px, Py), (-Py, Px) keeps the
     /// winding. ZRotation maps unit P to `+X` (row 1 of the paper's ZRotation); `w`
     /// is unchanged.
+    ///
+    /// `rot_z = [(Px, -Py, 0, 0), (Py, Px, 0, 0), Z, W]` (columns) times
+    /// `projection = [(1, 0, 0, Px lengthP), (0, 1, 0, Py lengthP), Z, W]`, written
+    /// out: each column of the product has one nonzero term per entry.
     fn matrix(self) -> DMat4 {
-        let (unit_p, length_p) = (UNIT_P, self.length_p);
-        let rot_z = DMat4::from_cols(
-            DVec4::new(unit_p.x, -unit_p.y, 0.0, 0.0),
-            DVec4::new(unit_p.y, unit_p.x, 0.0, 0.0),
-            DVec4::new(0.0, 0.0, 1.0, 0.0),
+        let (p, length_p) = (UNIT_P, self.length_p);
+        DMat4::from_cols(
+            DVec4::new(p.x, -p.y, 0.0, p.x * length_p),
+            DVec4::new(p.y, p.x, 0.0, p.y * length_p),
+            DVec4::Z,
             DVec4::W,
-        );
-        let projection = DMat4::from_cols(
-            DVec4::new(1.0, 0.0, 0.0, unit_p.x * length_p),
-            DVec4::new(0.0, 1.0, 0.0, unit_p.y * length_p),
-            DVec4::new(0.0, 0.0, 1.0, 0.0),
-            DVec4::W,
-        );
-        rot_z * projection
+        )
     }
 
     /// `matrix() * p.extend(1.0)` for unit P along `+Y` ([`UNIT_P`]):
@@ -684,7 +711,11 @@ impl Ppls {
 /// between a vertex in front and one behind (a superset of the clipped hull's
 /// vertices). `None` when no vertex has `w >= eps_w`. The points are bounded as they
 /// are made, never stored.
-fn clipped_bounds(ppls: Ppls, points: &[DVec3], eps_w: f64) -> Option<(Bounds, (f64, f64))> {
+fn clipped_bounds<const N: usize>(
+    ppls: Ppls,
+    points: &ArrayVec<DVec3, N>,
+    eps_w: f64,
+) -> Option<(Bounds, (f64, f64))> {
     let mut acc = CloudBounds::EMPTY;
     if ppls.length_p == 0.0 {
         // Every `w` is 1, above `eps_w` (below 1): nothing to clip, and the
@@ -697,21 +728,23 @@ fn clipped_bounds(ppls: Ppls, points: &[DVec3], eps_w: f64) -> Option<(Bounds, (
         acc.any = !points.is_empty();
         return acc.finish();
     }
-    let mut behind = false;
+    // The points in front of the plane and behind it, each made once.
+    let (mut front, mut behind) = (ArrayVec::<Hom, N>::new(), ArrayVec::<Hom, N>::new());
     for p in points {
         let h = ppls.hom(*p);
         acc.add(h, eps_w);
-        behind |= h.w < eps_w;
+        // As many of either as there are points.
+        if h.w < eps_w {
+            let _ = behind.try_push(h);
+        } else if h.w >= eps_w {
+            let _ = front.try_push(h);
+        }
     }
-    if !behind {
-        // Nothing to clip (the usual case): no pair to visit.
-        return acc.finish();
-    }
-    let hom = || points.iter().map(|p| ppls.hom(*p));
-    for a in hom().filter(|h| h.w >= eps_w) {
-        for b in hom().filter(|h| h.w < eps_w) {
+    // Nothing behind (the usual case): no pair to visit.
+    for a in &front {
+        for b in &behind {
             let t = (a.w - eps_w) / (a.w - b.w);
-            let mut c = a + (b - a) * t;
+            let mut c = *a + (*b - *a) * t;
             c.w = eps_w;
             acc.add(c, eps_w);
         }

@@ -230,7 +230,7 @@ fn the_predictions_fit_is_the_fit_at_the_chosen_strength() {
         let body = FocusBody::new(&camera, light, &scene).unwrap();
         for reversed_z in [false, true] {
             let o = LispsmOptions::default().with_reversed_z(reversed_z);
-            let (s, _) = warp_strength(&body.focus, &body.view, &o);
+            let (s, _) = warp_strength(&body.focus, &o);
             let mut fits = Fits::new();
             let chosen = chosen_strength(&body, s, 1.0, reversed_z, &mut fits);
             let Some(fitted) = chosen.kept.and_then(|t| fits.at(t)) else {
@@ -259,7 +259,7 @@ fn scale_zero_is_the_uniform_strength_whatever_the_prediction() {
             assert_eq!(scaled_strength(&body.focus, s, 0.0), 0.0, "{s}");
         }
         let o = LispsmOptions::default();
-        let (s, _) = warp_strength(&body.focus, &body.view, &o);
+        let (s, _) = warp_strength(&body.focus, &o);
         assert_eq!(
             chosen_strength(&body, s, 0.0, false, &mut Fits::new()).s,
             0.0

@@ -38,13 +38,16 @@ fn probe(lit: f64) -> (Probe, Vec<Point>) {
 /// [`Probe::strength`] of `probe` with its perspective set.
 fn strength(
     (probe, perspective): &(Probe, Vec<Point>),
-    clip: impl FnMut(f64) -> Option<DMat4>,
+    mut clip: impl FnMut(f64) -> Option<DMat4>,
 ) -> f64 {
     let mut points = ProbePoints::new();
     for q in perspective {
         points.push(q, &DMat4::IDENTITY);
     }
-    probe.strength_with(&mut Fits::new(), clip, |c| c, &points)
+    // Strength 0's errors, as `Probe::fill` predicts them for the uniform fit.
+    let uniform = clip(0.0).expect("the fit at strength 0");
+    let uniform_error = [&probe.points, &points].map(|set| points_error(set, &uniform));
+    probe.strength_with(&mut Fits::new(), clip, |c| c, (&points, uniform_error))
 }
 
 /// With no front-lit face the strength is the one of least perspective-only

@@ -124,3 +124,50 @@ proptest::proptest! {
         proptest::prop_assert_eq!(ppls.hom(p), ppls.matrix() * p.extend(1.0));
     }
 }
+
+/// The baseline every warp's strength is judged against, predicted once per body
+/// (`Probe::fill`), is each warp's own fit at strength 0: LiSPSM's and TSM's
+/// exactly (the same fit), XPSM's orthographic fit to rounding where the caster
+/// box holds the receivers' footprint, and finer where that box cuts it.
+#[test]
+fn the_bodys_uniform_error_is_every_warps_strength_zero() {
+    let cam = camera();
+    let ground = Aabb::new(Vec3::new(-100.0, -1.0, -100.0), Vec3::new(100.0, 0.0, 0.0));
+    let tall = Aabb::new(Vec3::new(-100.0, -1.0, -100.0), Vec3::new(100.0, 20.0, 0.0));
+    // Casters on one side of the street only: their box cuts the footprint.
+    let one_side = Aabb::new(Vec3::new(0.0, -1.0, -100.0), Vec3::new(100.0, 20.0, 0.0));
+    let lights = [
+        Vec3::new(0.3, -1.0, 0.6),
+        Vec3::new(0.0, -0.3, -1.0),
+        Vec3::new(1.0, -0.4, 0.1),
+        Vec3::new(-0.2, -1.0, 0.05),
+    ];
+    let mut cut = 0;
+    for (casters, cuts) in [(tall, false), (one_side, true)] {
+        let scene = SceneBounds::new(ground, casters);
+        for light in lights {
+            let body = FocusBody::new(&cam, light, &scene).unwrap();
+            let (f, view) = (&body.focus, &body.view);
+            let probe = body.probe();
+            let uniform = crate::lispsm::warp_clip(f, view, 0.0, true).unwrap();
+            let (lispsm, baseline) = probe.lit_errors(&uniform.clip_from_light);
+            assert!(baseline.is_finite() && baseline > 0.0, "{light}");
+            assert_eq!(lispsm, baseline, "{light}");
+            let options = XpsmOptions::default();
+            let thr = f64::from(options.miner_lamp_threshold);
+            let weight = smoothstep(thr, 2.0 * thr, f.sin_gamma);
+            let (_, shift) = auto_length(f, view, weight);
+            let space = XpsmSpace::new(view, f, &options, shift);
+            let fit = xpsm_fit(&space, f, &options, 0.0).unwrap();
+            let (xpsm, _) = probe.lit_errors(&fit.clip_from_light);
+            let ratio = xpsm / baseline;
+            if cuts {
+                assert!(ratio <= 1.0 + 1e-9, "{light}: {ratio}");
+                cut += usize::from(ratio < 0.99);
+            } else {
+                assert!((ratio - 1.0).abs() < 1e-9, "{light}: {ratio}");
+            }
+        }
+    }
+    assert!(cut >= 2, "{cut}");
+}
