@@ -104,6 +104,7 @@ mod scene_bounds;
 mod selector;
 mod split;
 mod spot;
+mod spot_rounding;
 mod valid;
 
 #[cfg(feature = "mint")]
@@ -138,6 +139,7 @@ pub use scene_bounds::{MAX_RESOLUTION, SceneBounds};
 pub use selector::TechniqueSelector;
 pub use split::{CascadeBlend, CascadeSplits, MAX_CASCADES, SplitScheme};
 pub use spot::{SpotShadow, fit_spot};
+pub use spot_rounding::{SPOT_ROUNDING_BUDGET, SpotRounding};
 pub use valid::ValidCamera;
 
 pub use glam;

@@ -2,7 +2,7 @@ use crate::body::ConvexBody;
 use crate::light::unit;
 use crate::mapping::{LightDirection, ShadowTransform};
 use crate::projection::{least_aligned_axis, look_to};
-use crate::{Frustum, FrustumError, Light, SceneBounds, math};
+use crate::{Frustum, FrustumError, Light, SPOT_ROUNDING_BUDGET, SceneBounds, SpotRounding, math};
 
 /// A perspective shadow map for a spot light, fitted to what the camera sees.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -134,23 +134,11 @@ pub fn fit_spot(
     })
 }
 
-/// The most the rounding of a spot map's `f32` matrices may separate the two ends
-/// of a light ray at its nearest receiver, in texture coordinates: a tenth of a
-/// texel of a `1024²` map. (A perspective map divides what its rounded `x`, `y`
-/// and `w` rows leave at the light's position, where they vanish in exact
-/// arithmetic, by the distance from the light: the window of a receiver seen
-/// edge-on 3 mm from a light 0.05 from the origin, 44 `f32` steps tall there, put
-/// the two ends of one ray 0.4 texels apart.)
-pub(crate) const RAY_ROUNDING: f64 = 0.1 / 1024.0;
-
 /// How far the rounding of the `f32` matrices of the window `tangents` (left,
-/// right, bottom, top) separates the two ends of a light ray at the distance
-/// `nearest` along the axis, in texture coordinates: what the stored rows leave
-/// at the light's position, `e`, over `w ≥ nearest` (`|u|, |v| ≤ 1`), by the
-/// depth pass's matrix and the lookup's (its rows summed in `f32`), less four
-/// `f32` steps of the light's coordinates over the distance from the light (what
-/// a point's own `f32` coordinates carry; up to `spread w`). Near and far do not
-/// enter those rows.
+/// right, bottom, top) moves a lookup's texture coordinates, and the two ends of a
+/// light ray apart, at the distance `nearest` along the axis
+/// ([`SpotRounding::texel`]). Near and far do not enter those rows; the depth's
+/// rounding, which no window changes, is not bounded here.
 fn ray_rounding(
     tangents: [f64; 4],
     light_from_world: &glam::DMat4,
@@ -166,17 +154,7 @@ fn ray_rounding(
         false,
         LightDirection::Position(light),
     );
-    let at_light = light.as_dvec3().extend(1.0);
-    let e_clip = (map.clip_from_world.as_dmat4() * at_light).abs();
-    let e_uv = (map.uv_from_world.as_dmat4() * at_light).abs();
-    let by_clip = 0.5 * (e_clip.x.max(e_clip.y) + e_clip.w);
-    let by_uv = e_uv.x.max(e_uv.y) + e_uv.w;
-    // A point's own f32 coordinates already carry a few steps of the light's over
-    // `w`: that much is allowed besides the budget.
-    let (tan_x, tan_y) = (l.abs().max(r.abs()), b.abs().max(t.abs()));
-    let spread = math::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y);
-    let slack = 4.0 * f64::from(f32::EPSILON) * f64::from(light.abs().max_element()) / spread;
-    (by_clip.max(by_uv) - slack).max(0.0) / nearest
+    SpotRounding::new(light, tangents, nearest).texel(&clip, &map)
 }
 
 /// The tangents of the directions to a region's points, seen from the light.
@@ -235,7 +213,7 @@ impl Window {
     }
 
     /// The tangents clamped to the cone `[-cone_tan, cone_tan]²`, where their
-    /// `rounding` (a window's [`ray_rounding`]) exceeds [`RAY_ROUNDING`] widened
+    /// `rounding` (a window's [`ray_rounding`]) exceeds [`SPOT_ROUNDING_BUDGET`] widened
     /// about their middles (within the cone), both sides by the least factor that
     /// keeps it within (bisection on its logarithm); the whole cone where even it
     /// does not, if it keeps the rounding within a texel.
@@ -255,7 +233,7 @@ impl Window {
             b.max(-cone_tan),
             t.min(cone_tan),
         );
-        if !(r > l && t > b) || rounding([l, r, b, t]) <= RAY_ROUNDING {
+        if !(r > l && t > b) || rounding([l, r, b, t]) <= SPOT_ROUNDING_BUDGET {
             return Ok([l, r, b, t]);
         }
         let scaled = |factor: f64| {
@@ -264,8 +242,9 @@ impl Window {
             [l, r, b, t]
         };
         let full = (2.0 * cone_tan / (r - l)).max(2.0 * cone_tan / (t - b));
-        if !(rounding(scaled(full)) <= RAY_ROUNDING) {
-            return if rounding(scaled(full)) <= 10.0 * RAY_ROUNDING {
+        let at_full = rounding(scaled(full));
+        if !(at_full <= SPOT_ROUNDING_BUDGET) {
+            return if at_full <= 10.0 * SPOT_ROUNDING_BUDGET {
                 Ok(scaled(full))
             } else {
                 Err(FrustumError::DegenerateFrustum)
@@ -274,7 +253,7 @@ impl Window {
         let (mut narrow, mut wide) = (0.0, math::ln(full));
         for _ in 0..30 {
             let middle = 0.5 * (narrow + wide);
-            if rounding(scaled(math::exp(middle))) <= RAY_ROUNDING {
+            if rounding(scaled(math::exp(middle))) <= SPOT_ROUNDING_BUDGET {
                 wide = middle;
             } else {
                 narrow = middle;

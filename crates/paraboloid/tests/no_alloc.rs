@@ -3,11 +3,9 @@
 //! plan), the cone fits alone and the map's lookups, under a
 //! counting global allocator.
 //!
-//! The binary has its own `main` (`harness = false` in Cargo.toml), so the test runs
-//! alone on the main thread: the counting allocator counts every thread, and
-//! libtest's main thread records the test it has just started (a map entry, a
-//! timeout entry) while the test's thread runs, which a loaded machine lets fall
-//! inside the measured region.
+//! The test runs alone on the main thread, without libtest's harness
+//! (`harness = false` in Cargo.toml; see `shadowmap_testgen::run_alone`), since the
+//! counting allocator counts every thread.
 
 use std::alloc::System;
 
@@ -19,12 +17,11 @@ use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
 #[global_allocator]
 static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
 
-#[allow(clippy::print_stdout)] // libtest's lines, so the count over all binaries has it.
 fn main() {
-    println!("\nrunning 1 test");
-    per_frame_path_does_not_allocate();
-    println!("test per_frame_path_does_not_allocate ... ok\n");
-    println!("test result: ok. 1 passed; 0 failed; 0 ignored; 0 measured; 0 filtered out\n");
+    shadowmap_testgen::run_alone(
+        "per_frame_path_does_not_allocate",
+        per_frame_path_does_not_allocate,
+    );
 }
 
 fn per_frame_path_does_not_allocate() {

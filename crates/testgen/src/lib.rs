@@ -37,14 +37,37 @@ pub mod warp;
 
 /// The configuration every property test uses: 1,000 cases from a fixed seed, so a
 /// CI run is reproducible and a failure replays exactly. The fuzz targets explore the
-/// same generators without a seed.
+/// same generators without a seed. `PROPTEST_CASES=<n>` in the environment runs
+/// `n` cases instead (the same seed: the first 1,000 are CI's), for a longer search,
+/// with rejected inputs allowed in proportion (a quarter of `n`, at least
+/// proptest's 1,024).
 pub fn proptest_config() -> ProptestConfig {
+    let cases: u32 = std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(1000);
     ProptestConfig {
-        cases: 1000,
+        cases,
+        max_global_rejects: (cases / 4).max(1024),
         failure_persistence: None,
         rng_seed: proptest::test_runner::RngSeed::Fixed(0x05AD_03A9),
         ..ProptestConfig::default()
     }
+}
+
+/// Runs `test`, named `name`, as the one test of a binary built without libtest's
+/// harness (`harness = false`), printing libtest's lines for it so that a count of
+/// the lines over every test binary includes it; a failure panics, exiting with an
+/// error as libtest would. The no-allocation tests run this way, alone on the main
+/// thread: their counting allocator counts every thread, and libtest's main thread
+/// records the test it has just started (a map entry, a timeout entry) while the
+/// test's thread runs, which a loaded machine lets fall inside the measured region.
+#[allow(clippy::print_stdout)] // libtest's lines.
+pub fn run_alone(name: &str, test: impl FnOnce()) {
+    println!("\nrunning 1 test");
+    test();
+    println!("test {name} ... ok\n");
+    println!("test result: ok. 1 passed; 0 failed; 0 ignored; 0 measured; 0 filtered out\n");
 }
 
 /// Result of a generator.

@@ -48,10 +48,10 @@
 //! from it, a warp along a window's narrow side).
 
 use arrayvec::ArrayVec;
-use glam::{DMat4, DVec2, DVec4, Mat4, Vec2, Vec3};
+use glam::{DMat4, DVec2, DVec4, Mat4, Vec2};
 use shadowmap_frustum::{
-    Camera, DepthBounds, Light, LightDirection, PredictOptions, SceneBounds, ShadowMapping,
-    ShadowTransform, SpotShadow, UV_FROM_CLIP, fit_spot, math, predict_errors,
+    Camera, DepthBounds, Light, LightDirection, PredictOptions, SPOT_ROUNDING_BUDGET, SceneBounds,
+    ShadowMapping, ShadowTransform, SpotRounding, SpotShadow, fit_spot, math, predict_errors,
 };
 
 use crate::{MAX_WARP_RATIO, WarpError};
@@ -174,17 +174,23 @@ pub fn spot_warp(
     let LightDirection::Position(position) = base.transform.light else {
         return Ok(keep);
     };
-    let rounding = Rounding::new(&base, position);
-    let formula = window.resolved(formula, &base, &rounding);
+    let rounding = SpotRounding::new(
+        position,
+        base.tangents.map(f64::from),
+        f64::from(base.receiver_depth.0),
+    );
+    let (formula, formula_map) = window.resolved(formula, &base, &rounding);
     // The formula's warp, weaker ones, the spot fit turned to the centre line, each
-    // where f32 resolves it (the formula's does by `resolved`; the others may round
-    // differently), then the spot fit itself.
+    // where f32 resolves it (the formula's by `resolved`, which made its map; the
+    // others may round differently), then the spot fit itself.
     let mut strengths: ArrayVec<f64, 5> = ArrayVec::new();
     let mut candidates: ArrayVec<ShadowTransform, 6> = ArrayVec::new();
-    for sigma in [1.0, 0.5, 0.25, 0.125, 0.0].map(|k| k * formula) {
-        let clip = window.clip(&base, sigma)?;
-        let map = stored(&base, &clip)?;
-        if rounding.bound(&clip, &map) <= ROUNDING_BUDGET {
+    for (k, sigma) in [1.0, 0.5, 0.25, 0.125, 0.0].map(|k| (k, k * formula)) {
+        let map = match formula_map {
+            Some(map) if k == 1.0 => Some(map),
+            _ => window.candidate(sigma, &base, &rounding)?,
+        };
+        if let Some(map) = map {
             strengths.push(sigma);
             candidates.push(map);
         }
@@ -381,35 +387,59 @@ impl Window {
     }
 
     /// The strongest strength up to `sigma` whose warped map `f32` resolves at the
-    /// receivers: within [`ROUNDING_BUDGET`] by `rounding`'s bound, found by
-    /// bisection on its logarithm (to a millionth of it); 0 when even a millionth of
-    /// `sigma` does not resolve.
-    fn resolved(&self, sigma: f64, base: &SpotShadow, rounding: &Rounding) -> f64 {
-        let resolves = |sigma: f64| {
-            self.clip(base, sigma).is_ok_and(|clip| {
-                stored(base, &clip).is_ok_and(|map| rounding.bound(&clip, &map) <= ROUNDING_BUDGET)
-            })
-        };
-        if !(sigma > 0.0) || resolves(sigma) {
-            return sigma;
+    /// receivers ([`Window::candidate`]), found by bisection on its logarithm (to a
+    /// millionth of it), with its map; 0 when even a millionth of `sigma` does not
+    /// resolve, and `sigma` itself, unchecked, where it is not positive (both
+    /// without a map).
+    fn resolved(
+        &self,
+        sigma: f64,
+        base: &SpotShadow,
+        rounding: &SpotRounding,
+    ) -> (f64, Option<ShadowTransform>) {
+        let resolves = |sigma: f64| self.candidate(sigma, base, rounding).ok().flatten();
+        if !(sigma > 0.0) {
+            return (sigma, None);
+        }
+        if let Some(map) = resolves(sigma) {
+            return (sigma, Some(map));
         }
         // A warp 1e-6 times as strong is the spot fit turned, to rounding.
         let (mut weak, mut strong) = (
             math::ln(sigma) - 6.0 * core::f64::consts::LN_10,
             math::ln(sigma),
         );
-        if !resolves(math::exp(weak)) {
-            return 0.0;
-        }
+        let Some(mut kept) = resolves(math::exp(weak)) else {
+            return (0.0, None);
+        };
         for _ in 0..24 {
             let middle = 0.5 * (weak + strong);
-            if resolves(math::exp(middle)) {
-                weak = middle;
-            } else {
-                strong = middle;
+            match resolves(math::exp(middle)) {
+                Some(map) => {
+                    weak = middle;
+                    kept = map;
+                }
+                None => strong = middle,
             }
         }
-        math::exp(weak)
+        (math::exp(weak), Some(kept))
+    }
+
+    /// The map of the warp of strength `sigma`, stored in `f32`, where `f32`
+    /// resolves it at the receivers (`rounding`'s bound within
+    /// [`SPOT_ROUNDING_BUDGET`]); `None` where it does not.
+    ///
+    /// # Errors
+    /// [`WarpError::Degenerate`] where the warp or its stored matrix is.
+    fn candidate(
+        &self,
+        sigma: f64,
+        base: &SpotShadow,
+        rounding: &SpotRounding,
+    ) -> Result<Option<ShadowTransform>, WarpError> {
+        let clip = self.clip(base, sigma)?;
+        let map = stored(base, &clip)?;
+        Ok((rounding.bound(&clip, &map) <= SPOT_ROUNDING_BUDGET).then_some(map))
     }
 
     /// The clip matrix of the warp of strength `sigma` after the spot fit (see the
@@ -466,95 +496,6 @@ fn stored(base: &SpotShadow, clip: &DMat4) -> Result<ShadowTransform, WarpError>
         base.transform.reversed_z,
         base.transform.light,
     ))
-}
-
-/// The most `f32` rounding may move a lookup of a warped map at a receiver (its
-/// texture coordinates, or the two ends of a light ray apart, or its depth): a
-/// tenth of a texel of a `1024²` map.
-const ROUNDING_BUDGET: f64 = 0.1 / 1024.0;
-
-/// How far the rounding of a warped spot map's `f32` matrices moves a lookup at the
-/// visible receivers: its texture coordinates, the two ends of a light ray apart,
-/// and its depth.
-///
-/// A stored row `r` (of `clip_from_world`, the depth pass's, or `uv_from_world`,
-/// the lookup's, its rows summed in `f32`) errs at a point `p` by its value at the
-/// light's position plus its rounding times `p - light`; a point at `w` carries
-/// that as a move of `r / w` by about `(|r(light)| + |w(light)|) / w` plus
-/// `(|δr|₁ + |δw|₁) |p - light| / w` (`δ` the rounding, `|r / w| ≤ 1`). In exact
-/// arithmetic the `x`, `y` and `w` rows (so `u w` and `v w`) vanish at the light:
-/// every light ray is one line through it, and what the stored rows leave there,
-/// divided by the small `w` of a point near the light, is what separates the two
-/// ends of a ray. Depth (`z / w`, with `z` nearly `w` where the warp compresses it
-/// toward the far value) reads the rounding alone. Inside the map `q ≥ 1`, so `w`
-/// is at least the distance `d ≥ nearest` along the spot's axis, and
-/// `|p - light| ≤ spread d`.
-struct Rounding {
-    /// The light's position, `(light, 1)`.
-    light: DVec4,
-    /// The nearest receivers' distance along the spot's axis.
-    nearest: f64,
-    /// The largest distance from the light per unit along its axis in the window.
-    spread: f64,
-    /// What a point's own `f32` coordinates already carry at `w`, times `w`
-    /// ([`F32_STEPS`] steps of the light's largest coordinate, over `spread`: the
-    /// point's distance from the light is up to `spread w`): allowed besides the
-    /// budget, so a region reaching the light's plane, whose points come
-    /// arbitrarily near it, keeps its warps.
-    slack: f64,
-}
-
-/// How many `f32` steps of the light's coordinates the matrices may add to a
-/// lookup at `w`, over `w`, besides [`ROUNDING_BUDGET`].
-const F32_STEPS: f64 = 4.0;
-
-impl Rounding {
-    fn new(base: &SpotShadow, light: Vec3) -> Self {
-        let [l, r, b, t] = base.tangents.map(f64::from);
-        let tan_x = l.abs().max(r.abs());
-        let tan_y = b.abs().max(t.abs());
-        let spread = math::sqrt(1.0 + tan_x * tan_x + tan_y * tan_y);
-        Self {
-            light: light.as_dvec3().extend(1.0),
-            nearest: f64::from(base.receiver_depth.0),
-            spread,
-            slack: F32_STEPS * f64::from(f32::EPSILON) * f64::from(light.abs().max_element())
-                / spread,
-        }
-    }
-
-    /// The bound, in texture coordinates and depth, for `map`, stored from the
-    /// exact clip matrix `clip`.
-    fn bound(&self, clip: &DMat4, map: &ShadowTransform) -> f64 {
-        let stored_clip = map.clip_from_world.as_dmat4();
-        let stored_uv = map.uv_from_world.as_dmat4();
-        let uv = UV_FROM_CLIP.as_dmat4() * *clip;
-        // Device coordinates span 2 across the map, texture coordinates 1.
-        let texel = |row: usize| {
-            self.moved(&stored_uv, &uv, row, false)
-                .max(0.5 * self.moved(&stored_clip, clip, row, false))
-        };
-        let depth = self.moved(&stored_clip, clip, 2, true);
-        texel(0).max(texel(1)).max(depth)
-    }
-
-    /// How far the rounding of `stored` (from `exact`) moves its row `row` over `w`
-    /// at a receiver; at the light, the stored rows' values, or with
-    /// `rounding_only` their rounding's.
-    fn moved(&self, stored: &DMat4, exact: &DMat4, row: usize, rounding_only: bool) -> f64 {
-        let rounding = |r: usize| stored.row(r) - exact.row(r);
-        let at_light = |r: usize| {
-            let value = if rounding_only {
-                rounding(r)
-            } else {
-                stored.row(r)
-            };
-            value.dot(self.light).abs()
-        };
-        let per_unit = |r: usize| rounding(r).truncate().abs().element_sum();
-        let at_light = (at_light(row) + at_light(3) - self.slack).max(0.0);
-        at_light / self.nearest + (per_unit(row) + per_unit(3)) * self.spread
-    }
 }
 
 #[cfg(feature = "serde")]
