@@ -87,6 +87,7 @@ impl SpotRounding {
     /// The rounding of a spot light at `light` whose window has the tangents
     /// `[left, right, bottom, top]`, looked up no nearer than `nearest` along its
     /// axis.
+    #[inline]
     #[must_use]
     pub fn new(light: Vec3, tangents: [f64; 4], nearest: f64) -> Self {
         let [l, r, b, t] = tangents;
@@ -104,6 +105,7 @@ impl SpotRounding {
 
     /// The bound of the texture coordinates' move, and of the two ends of a light
     /// ray apart, for `map`, stored from the exact clip matrix `clip`.
+    #[inline]
     #[must_use]
     pub fn texel(&self, clip: &DMat4, map: &ShadowTransform) -> f64 {
         let stored_clip = map.clip_from_world.as_dmat4();
@@ -119,6 +121,7 @@ impl SpotRounding {
 
     /// [`SpotRounding::texel`] and the depth's move: the bound a map's lookups are
     /// held to (`≤` [`SPOT_ROUNDING_BUDGET`]).
+    #[inline]
     #[must_use]
     pub fn bound(&self, clip: &DMat4, map: &ShadowTransform) -> f64 {
         let depth = self.moved(&map.clip_from_world.as_dmat4(), clip, 2, true);
@@ -128,6 +131,7 @@ impl SpotRounding {
     /// How far the rounding of `stored` (from `exact`) moves its row `row` over `w`
     /// at a receiver; at the light, the stored rows' values, or with
     /// `rounding_only` their rounding's.
+    #[inline]
     fn moved(&self, stored: &DMat4, exact: &DMat4, row: usize, rounding_only: bool) -> f64 {
         let rounding = |r: usize| stored.row(r) - exact.row(r);
         let at_light = |r: usize| {

@@ -560,6 +560,11 @@ fn xpsm_fit(
         m.z_axis,
         *m * light_space.w_axis.truncate().extend(1.0),
     );
+    // A region beyond what f64 resolves (a caster box 1e30 from the receivers)
+    // overflows its scale or offset: refused here, before the prediction reads it.
+    if !(clip_from_light_space.is_finite() && clip_from_light.is_finite()) {
+        return Err(WarpError::Degenerate);
+    }
     Ok(XpsmFit {
         clip_from_light_space,
         clip_from_light,

@@ -171,3 +171,28 @@ fn the_bodys_uniform_error_is_every_warps_strength_zero() {
     }
     assert!(cut >= 2, "{cut}");
 }
+
+/// A caster box 1e30 from the receivers (found by the fuzz target `warp_xpsm`):
+/// the focus region's scale and offset overflow, and the prediction read a clip
+/// matrix of NaNs (a debug assertion on its structure failed). The fit refuses it
+/// with a typed error, as the whole call does.
+#[test]
+fn a_caster_box_beyond_f64_is_refused_before_the_prediction() {
+    let camera = Camera {
+        world_from_view: glam::Mat4::IDENTITY,
+        projection: Projection::perspective(1.0, 1.5, 0.1, 100.0),
+        reversed_z: true,
+    };
+    let receivers = Aabb::new(
+        Vec3::new(-2.22786, -2.22786, -52.27786),
+        Vec3::new(2.22786, 2.22786, -47.82214),
+    );
+    let casters = Aabb::new(
+        Vec3::splat(-2.396108e30),
+        Vec3::new(-2.396108e30, -2.396108e30, 3.3003e-41),
+    );
+    let light = Vec3::new(0.00015502599, -1.0, -3.295181e-5);
+    let scene = SceneBounds::new(receivers, casters);
+    let fitted = xpsm(&camera, light, &scene, &XpsmOptions::default());
+    assert!(fitted.is_err(), "{fitted:?}");
+}
