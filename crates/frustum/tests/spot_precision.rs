@@ -4,7 +4,8 @@
 
 use glam::{DVec3, Mat4, Vec3, Vec4};
 use shadowmap_frustum::{
-    Aabb, Camera, ConvexBody, FrustumError, Light, Projection, SceneBounds, fit_spot,
+    Aabb, Camera, ConvexBody, FrustumError, Light, Projection, SceneBounds, ShadowTransform,
+    fit_spot,
 };
 use shadowmap_testgen::frustum::ray_gap;
 
@@ -16,6 +17,20 @@ fn region_points(body: &ConvexBody) -> Vec<DVec3> {
         points.extend(v[i + 1..].iter().map(|b| ((*a + *b) * 0.5).as_dvec3()));
     }
     points
+}
+
+/// Every light ray from `light` through a point of `body` (its vertices and their
+/// midpoints) has its two ends within a tenth of a `1024²` texel in `map`, and at
+/// least one such ray is in the map.
+fn assert_rays_on_one_texel(map: &ShadowTransform, light: Vec3, body: &ConvexBody) {
+    let mut checked = 0;
+    for p in region_points(body) {
+        if let Some(gap) = ray_gap(map, light.as_dvec3(), p) {
+            assert!(gap <= 1e-4, "{p}: the ray's ends {gap} apart");
+            checked += 1;
+        }
+    }
+    assert!(checked > 0);
 }
 
 /// A spot 0.05 from the origin lighting, from its own position along the view, a
@@ -50,18 +65,10 @@ fn a_window_finer_than_f32_resolves_is_widened() {
     let spot = fit_spot(&light, &frustum, Some(&scene), false).unwrap();
 
     let body = ConvexBody::from_frustum_aabb(&frustum, &receivers).unwrap();
-    let points = region_points(&body);
     // The slab's own window is 5.7e-5 tall: widened.
     let [_, _, b, t] = spot.tangents;
     assert!(t - b > 1e-3, "{b} {t}");
-    let mut checked = 0;
-    for p in points {
-        if let Some(gap) = ray_gap(&spot.transform, position.as_dvec3(), p) {
-            assert!(gap <= 1e-4, "{p}: the ray's ends {gap} apart");
-            checked += 1;
-        }
-    }
-    assert!(checked > 0);
+    assert_rays_on_one_texel(&spot.transform, position, &body);
 }
 
 /// A street-lamp spot over a ground plane: the window `f32` resolves is the
@@ -164,14 +171,7 @@ fn an_off_axis_window_is_widened_by_its_tangents() {
     )
     .unwrap();
     let body = ConvexBody::from_frustum_aabb(&frustum, &receivers).unwrap();
-    let mut checked = 0;
-    for p in region_points(&body) {
-        if let Some(gap) = ray_gap(&spot.transform, position.as_dvec3(), p) {
-            assert!(gap <= 1e-4, "{p}: the ray's ends {gap} apart");
-            checked += 1;
-        }
-    }
-    assert!(checked > 0);
+    assert_rays_on_one_texel(&spot.transform, position, &body);
 }
 
 /// A spot of half angle 0.01, 5,000 from the origin, 0.1 from its nearest visible

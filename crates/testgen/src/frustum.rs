@@ -8,8 +8,9 @@ use arbitrary::Unstructured;
 use glam::{DVec2, DVec3, Mat4, Vec3};
 use shadowmap_frustum::{
     Aabb, Camera, Cascade, CascadeFit, CascadeOptions, CascadeSet, CascadeSplits, CascadeState,
-    ConvexBody, DepthBounds, Frustum, Light, SceneBounds, ShadowMapping, ShadowSample,
-    ShadowTransform, SplitScheme, SpotShadow, ValidCamera, directional_light_from_world, fit_spot,
+    ConvexBody, DepthBounds, Frustum, Light, SPOT_ROUNDING_BUDGET, SceneBounds, ShadowMapping,
+    ShadowSample, ShadowTransform, SplitScheme, SpotShadow, ValidCamera,
+    directional_light_from_world, fit_spot,
 };
 
 /// The crate these generators build values of. `shadowmap-frustum`'s own unit tests
@@ -511,13 +512,14 @@ pub fn check_spot(case: &SpotCase) {
 pub fn spot_ray_tolerance(spot: &SpotShadow, half_angle: f32, light: DVec3, p: DVec3) -> f64 {
     let cone = 2.0 * f64::from(half_angle).tan() * (1.0 - 1e-6);
     let [l, r, b, t] = spot.tangents.map(f64::from);
-    let texels = if r - l >= cone || t - b >= cone {
-        1.0
+    // The fit's own budget (a tenth of a texel), or the texel it allows a whole cone.
+    let budget = if r - l >= cone || t - b >= cone {
+        10.0 * SPOT_ROUNDING_BUDGET
     } else {
-        0.1
+        SPOT_ROUNDING_BUDGET
     };
-    let scale = p.abs().max_element().max(light.abs().max_element()) / (p - light).length();
-    texels / 1024.0 + 1e-6 * scale
+    let distance = (p - light).length().max(1e-30);
+    budget + 1e-6 * p.abs().max_element().max(light.abs().max_element()) / distance
 }
 
 /// How far apart (largest `uv` difference) `map` stores `p` and the point halfway

@@ -166,17 +166,14 @@ impl FocusBody {
 fn tsm_body(body: &FocusBody, options: &TsmOptions) -> Result<TsmShadow, WarpError> {
     let (view, f) = (&body.view, &body.focus);
     let fade = options.fade.weight(f.sin_gamma);
-    // Top and base edges: the receivers' extent along the centre line.
-    let (mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY);
-    let (mut z_n, mut z_f) = (f64::INFINITY, f64::NEG_INFINITY);
+    // Top and base edges: the receivers' extent along the centre line (their
+    // light-space footprint's), and their view-depth range.
+    let (y0, y1) = (f.footprint.min.y, f.footprint.max.y);
+    let (z_n, z_f) = f.receiver_depth;
     let mut yd: ArrayVec<(f64, f64), MAX_BODY_VERTICES> = ArrayVec::new();
     for p in &f.receivers {
         let y = f.rot.transform_point3(*p).y;
-        y0 = y0.min(y);
-        y1 = y1.max(y);
         let d = (*p - view.eye).dot(view.forward);
-        z_n = z_n.min(d);
-        z_f = z_f.max(d);
         yd.push((y, d));
     }
     let lambda = y1 - y0;
